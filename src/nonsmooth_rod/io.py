@@ -1,0 +1,90 @@
+"""Writing results: every file is written to a temporary sibling and renamed into place, so an
+interrupted run never leaves a half-written file where a complete one is expected."""
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike):
+    """Yield a temporary path next to `path`; rename it over `path` only on success."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def write_text(path, text: str) -> None:
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+def _json_default(obj):
+    if isinstance(obj, (np.floating, np.integer)):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+def _finite_or_none(obj):
+    """JSON has no NaN/Infinity: write null instead of an invalid token."""
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _finite_or_none(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite_or_none(v) for v in obj]
+    return obj
+
+
+def dumps_json(data) -> str:
+    return json.dumps(_finite_or_none(json.loads(json.dumps(data, default=_json_default))), indent=2,
+                      allow_nan=False) + "\n"
+
+
+def write_json(path, data) -> None:
+    write_text(path, dumps_json(data))
+
+
+def write_csv(path, columns: dict, order=None) -> None:
+    """Columns of equal length; floats with 17 significant digits (round-trip exact)."""
+    order = list(order or columns.keys())
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(order)
+    cols = [columns[name] for name in order]
+    for row in zip(*cols):
+        writer.writerow([f"{x:.17g}" if isinstance(x, (float, np.floating)) else x for x in row])
+    write_text(path, buf.getvalue())
+
+
+def read_csv(path) -> dict:
+    """Read a CSV written by write_csv: numeric columns as float arrays, others as str arrays."""
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    header, body = rows[0], rows[1:]
+    out = {}
+    for j, name in enumerate(header):
+        col = [r[j] for r in body]
+        try:
+            out[name] = np.array([float(x) for x in col])
+        except ValueError:
+            out[name] = np.array(col, dtype=object)
+    return out

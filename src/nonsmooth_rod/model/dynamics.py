@@ -1,0 +1,85 @@
+"""Acceleration-level contact dynamics of a scene for a given assignment of contact modes.
+
+For each contact in a mode, Siconos-style: a closed contact keeps g̈ = H_N a + Ḣ_N v = 0 with
+N ≥ 0; a sticking contact also keeps the slip acceleration H_T a + Ḣ_T v = 0 with |T| ≤ μs N;
+a sliding contact carries T = −s μd N (s = sign of the slip velocity). The unknowns
+(a, N, T) follow from one linear system (the mass matrix is constant and diagonal):
+
+    a = M⁻¹ (f + Σ H_Nᵀ N + H_Tᵀ T),     A λ = −(Ḣ v + C M⁻¹ f),   A = C M⁻¹ G.
+
+A sliding mode whose A loses positivity is the Painlevé situation: no or several solutions.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contacts import ContactKinematics
+from .scene import Scene
+
+SLIP_SIGN = {"slip+": 1.0, "slip-": -1.0}
+
+
+@dataclass
+class ModeDynamics:
+    a: np.ndarray
+    normal_force: np.ndarray  # per contact (0 when open)
+    tangential_force: np.ndarray
+    matrix: np.ndarray  # A of the constrained system (may be empty)
+    singular: bool
+
+
+def mode_dynamics(scene: Scene, t: float, q: np.ndarray, v: np.ndarray,
+                  modes, kin: list[ContactKinematics] | None = None) -> ModeDynamics:
+    """Accelerations and contact forces with each contact in the given mode."""
+    kin = kin if kin is not None else scene.kinematics(q, v)
+    minv = scene.inverse_mass_diagonal
+    f = scene.force(t, q, v)
+    rows, cols, rhs, owners = [], [], [], []
+    for i, (k, mode) in enumerate(zip(kin, modes)):
+        if mode == "open":
+            continue
+        mu_d = scene.contacts[i].law.friction.mu_d
+        rows.append(k.H_N)
+        rhs.append(k.drift_N)
+        if mode == "stick":
+            cols.append(k.H_N)
+            cols.append(k.H_T)
+            rows.append(k.H_T)
+            rhs.append(k.drift_T)
+            owners.append((i, "N"))
+            owners.append((i, "T"))
+        else:
+            cols.append(k.H_N - SLIP_SIGN[mode] * mu_d * k.H_T)
+            owners.append((i, "N+slip"))
+    nc = len(kin)
+    normal = np.zeros(nc)
+    tangential = np.zeros(nc)
+    free_acc = minv * f
+    if not rows:
+        return ModeDynamics(free_acc, normal, tangential, np.zeros((0, 0)), False)
+    C = np.array(rows)
+    G = np.array(cols).T
+    A = C @ (minv[:, None] * G)
+    b = -(np.array(rhs) + C @ free_acc)
+    singular = False
+    try:
+        if abs(np.linalg.det(A)) < 1e-12 * max(1.0, np.abs(A).max()) ** len(A):
+            raise np.linalg.LinAlgError
+        lam = np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        # Redundant constraints (e.g. two sticking contacts of one body at rest): forces are
+        # statically indeterminate; the least-norm forces still give the unique motion.
+        singular = True
+        lam = np.linalg.lstsq(A, b, rcond=None)[0]
+    for (i, role), value in zip(owners, lam):
+        if role == "N":
+            normal[i] = value
+        elif role == "T":
+            tangential[i] = value
+        else:
+            normal[i] = value
+            tangential[i] = -SLIP_SIGN[modes[i]] * scene.contacts[i].law.friction.mu_d * value
+    a = free_acc + minv * (G @ lam)
+    return ModeDynamics(a, normal, tangential, A, singular)

@@ -1,0 +1,61 @@
+"""A scene: bodies, their contacts, gravity and any other applied force."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..validation import InputError, require_finite
+from .body import RigidBody
+
+AppliedForce = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+
+
+@dataclass
+class Scene:
+    """Planar rigid bodies with contacts.
+
+    q and v stack (x, y, θ) and (ẋ, ẏ, θ̇) of every body's centre of mass. `applied_force`,
+    if given, returns the generalised force (forces on the centre of mass, torque) besides gravity.
+    """
+
+    bodies: Sequence[RigidBody]
+    contacts: Sequence = ()
+    gravity: float = 9.81
+    applied_force: AppliedForce | None = None
+
+    def __post_init__(self):
+        require_finite("g", self.gravity)
+        if self.gravity < 0:
+            raise InputError(f"g must be non-negative, got {self.gravity!r}")
+        if not self.bodies:
+            raise InputError("a scene needs at least one body")
+        self.bodies = list(self.bodies)
+        self.contacts = list(self.contacts)
+        self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
+        self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
+        self.weight = np.zeros(self.n_dof)
+        self.weight[1::3] = -self.gravity * self.mass_diagonal[0::3]
+
+    @property
+    def n_dof(self) -> int:
+        return 3 * len(self.bodies)
+
+    def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        if self.applied_force is None:
+            return self.weight
+        return self.weight + np.asarray(self.applied_force(t, q, v), dtype=float)
+
+    def kinematics(self, q: np.ndarray, v: np.ndarray):
+        return [c.kinematics(q, v, self.n_dof) for c in self.contacts]
+
+    def kinetic_energy(self, v: np.ndarray) -> float:
+        return 0.5 * float(np.dot(self.mass_diagonal * v, v))
+
+    def potential_energy(self, q: np.ndarray) -> float:
+        return self.gravity * float(np.dot(self.mass_diagonal[0::3], q[1::3]))
+
+    def energy(self, q: np.ndarray, v: np.ndarray) -> float:
+        """Kinetic + gravitational energy (applied forces are not included)."""
+        return self.kinetic_energy(v) + self.potential_energy(q)

@@ -1,0 +1,119 @@
+"""Two-coefficient Coulomb friction as a sequence of ordinary one-step problems.
+
+The exact law (sgn(0) = 0) splits as  T ∈ −μs N Sign(v_T) + (μs − μd) N sgn(v_T): a monotone
+Coulomb part with μs plus a single-valued part. For a guessed slip sign s of each contact
+the single-valued part is the shift c = (μs − μd) s of the friction interval,
+
+    p_T ∈ [(c − μs) p_N, (c + μs) p_N],
+
+which keeps the step an ordinary LCP (PlanarFrictionProblem). The guess is then checked against
+the slip velocity the step produced, and the step is solved again with the corrected signs
+until the impulses obey the exact law at the end-of-step velocity:
+
+    u_T > 0 ⇒ p_T = −μd p_N,   u_T < 0 ⇒ p_T = +μd p_N,   u_T = 0 ⇒ |p_T| ≤ μs p_N.
+
+Because stick is accepted under any guess whenever |p_T| ≤ μs p_N, a sliding contact that comes
+to rest re-sticks in the very step in which μs can hold it, whatever h is: this is what the
+naive "μd if it slid last step" rule gets wrong. See docs/friction.md.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import solvers as _solvers
+from .solvers.problem import PlanarFrictionProblem, SolverError
+
+
+@dataclass
+class StepContactResult:
+    p: np.ndarray
+    u: np.ndarray
+    states: list[str]  # per contact: open / stick / slip+ / slip-
+    slip_signs: np.ndarray  # the converged guess s per contact (0, ±1)
+    solves: int
+    iterations: int
+    residual: float
+    consistent: bool
+
+
+def classify(p: np.ndarray, u: np.ndarray, mu_s: np.ndarray, velocity_tol: float,
+             impulse_tol: float) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """Contact states of a step solution, the slip signs they imply, and their consistency."""
+    n = len(mu_s)
+    states = []
+    signs = np.zeros(n)
+    consistent = np.ones(n, dtype=bool)
+    for i in range(n):
+        pN, pT, uT = p[2 * i], p[2 * i + 1], u[2 * i + 1]
+        if pN <= impulse_tol:
+            states.append("open")
+            continue
+        if uT > velocity_tol:
+            states.append("slip+")
+            signs[i] = 1.0
+        elif uT < -velocity_tol:
+            states.append("slip-")
+            signs[i] = -1.0
+        else:
+            states.append("stick")
+            # Sticking is admissible only inside the static cone; otherwise the contact slips
+            # against the friction it could not supply.
+            if abs(pT) > mu_s[i] * pN * (1 + 1e-9) + impulse_tol:
+                consistent[i] = False
+                signs[i] = -np.sign(pT)
+    return states, signs, consistent
+
+
+def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
+                          slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
+                          max_solves: int = 6) -> StepContactResult:
+    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`."""
+    mu_s = np.asarray(mu_s, dtype=float)
+    mu_d = np.asarray(mu_d, dtype=float)
+    guess = np.array(slip_guess, dtype=float)
+    scale_v = max(1e-12, float(np.max(np.abs(q))))
+    velocity_tol = 1e-9 * scale_v
+    tried = set()
+    iterations = 0
+    best = None
+    for solves in range(1, max_solves + 1):
+        key = tuple(guess)
+        tried.add(key)
+        shift = (mu_s - mu_d) * guess
+        problem = PlanarFrictionProblem(W, q, shift - mu_s, shift + mu_s)
+        sol = _solvers.solve(problem, solver, **(solver_options or {}))
+        iterations += sol.iterations
+        p, u = sol.p, sol.u
+        scale_p = max(1e-300, float(np.max(np.abs(p))))
+        states, implied, ok = classify(p, u, mu_s, velocity_tol, 1e-12 * scale_p)
+        # A guess is consistent for a contact when the step slid the way the guess said, or
+        # stuck inside the static cone (any guess), or opened.
+        for i, st in enumerate(states):
+            if st in ("slip+", "slip-") and implied[i] != guess[i]:
+                ok[i] = False
+        best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
+        if ok.all():
+            return best
+        new_guess = guess.copy()
+        for i in range(len(guess)):
+            if not ok[i]:
+                new_guess[i] = implied[i]
+        if tuple(new_guess) in tried:
+            break
+        guess = new_guess
+    # Cycling between guesses (possible only with several interacting contacts): keep the
+    # ordinary μs solution, which is exact for sticking, and let the caller count it.
+    if best is not None and not best.consistent:
+        zero = np.zeros_like(guess)
+        if tuple(zero) not in tried:
+            problem = PlanarFrictionProblem(W, q, -mu_s, mu_s)
+            sol = _solvers.solve(problem, solver, **(solver_options or {}))
+            states, implied, _ = classify(sol.p, sol.u, mu_s, velocity_tol, 1e-12 * max(1e-300, np.max(np.abs(sol.p))))
+            best = StepContactResult(sol.p, sol.u, states, zero, best.solves + 1,
+                                     iterations + sol.iterations, sol.residual, False)
+    return best
+
+
+__all__ = ["solve_two_coefficient", "StepContactResult", "classify", "SolverError"]

@@ -1,0 +1,137 @@
+"""What a simulation returns: trajectory samples, contact phases, events, impacts, status.
+
+Shaped after scipy's OdeResult: one object with named fields, a `status` word and a
+human `message`, whatever integrator produced it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+MODES = ("stick", "slip+", "slip-", "flight")
+# Contact-state words used per contact by every integrator ("open" = no contact).
+CONTACT_STATES = ("open", "stick", "slip+", "slip-")
+
+
+@dataclass
+class Phase:
+    """A maximal time interval in which one contact keeps one mode."""
+
+    mode: str
+    t_start: float
+    t_end: float
+
+    @property
+    def duration(self) -> float:
+        return self.t_end - self.t_start
+
+    def as_dict(self) -> dict:
+        return {"mode": self.mode, "t_start": self.t_start, "t_end": self.t_end}
+
+
+@dataclass
+class Event:
+    """A located switching event: what happened, when, at which contact."""
+
+    t: float
+    kind: str
+    contact: str = ""
+    detail: dict = field(default_factory=dict)
+
+
+@dataclass
+class Impact:
+    """An impact: generalised velocities just before and after, and the impulses (N·s)."""
+
+    t: float
+    contact: str
+    q: np.ndarray
+    v_before: np.ndarray
+    v_after: np.ndarray
+    normal_impulse: np.ndarray
+    tangential_impulse: np.ndarray
+
+
+@dataclass
+class Trajectory:
+    """Samples of the scene's state; forces are per contact (N and T in newtons).
+
+    For time-stepping, forces are the step's impulses divided by h, and `modes` the contact
+    states found by the step ending at `t`.
+    """
+
+    t: np.ndarray
+    q: np.ndarray  # (n, n_dof)
+    v: np.ndarray  # (n, n_dof)
+    a: np.ndarray  # (n, n_dof); NaN where undefined
+    normal_force: np.ndarray  # (n, n_contacts)
+    tangential_force: np.ndarray  # (n, n_contacts)
+    modes: np.ndarray  # (n, n_contacts) of contact-state words
+
+
+@dataclass
+class SimulationResult:
+    method: str
+    status: str  # "ok", "painleve", "zeno", "liftoff", "failed", ...
+    message: str
+    trajectory: Trajectory
+    contact_names: list[str]
+    events: list[Event] = field(default_factory=list)
+    impacts: list[Impact] = field(default_factory=list)
+    phases: dict[str, list[Phase]] = field(default_factory=dict)  # per contact name
+    steps: int = 0
+    cpu_time_s: float = 0.0
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.trajectory.t
+
+
+def phases_from_intervals(t_bounds, modes, min_duration: float = 0.0) -> list[Phase]:
+    """Contiguous phases from per-interval modes: modes[i] holds on [t_bounds[i], t_bounds[i+1]].
+
+    Phases shorter than `min_duration` (one-step blips of time-stepping at a slip reversal)
+    are merged into their neighbours: into the previous phase, or the next one at the start.
+    """
+    t_bounds = np.asarray(t_bounds, dtype=float)
+    modes = list(modes)
+    if len(modes) != len(t_bounds) - 1:
+        raise ValueError("need one mode per interval: len(modes) == len(t_bounds) - 1")
+    phases: list[Phase] = []
+    for i, mode in enumerate(modes):
+        if phases and phases[-1].mode == mode:
+            phases[-1].t_end = t_bounds[i + 1]
+        else:
+            phases.append(Phase(mode, float(t_bounds[i]), float(t_bounds[i + 1])))
+    return merge_short_phases(phases, min_duration)
+
+
+def merge_short_phases(phases: list[Phase], min_duration: float) -> list[Phase]:
+    if min_duration <= 0 or len(phases) < 2:
+        return _join_equal(phases)
+    out: list[Phase] = []
+    for ph in phases:
+        if ph.duration < min_duration and out:
+            out[-1] = Phase(out[-1].mode, out[-1].t_start, ph.t_end)
+        else:
+            out.append(Phase(ph.mode, ph.t_start, ph.t_end))
+    if len(out) > 1 and out[0].duration < min_duration:
+        out[1] = Phase(out[1].mode, out[0].t_start, out[1].t_end)
+        out.pop(0)
+    return _join_equal(out)
+
+
+def _join_equal(phases: list[Phase]) -> list[Phase]:
+    out: list[Phase] = []
+    for ph in phases:
+        if out and out[-1].mode == ph.mode:
+            out[-1] = Phase(ph.mode, out[-1].t_start, ph.t_end)
+        else:
+            out.append(ph)
+    return out

@@ -1,0 +1,128 @@
+"""One entry point for the paper's rod: `simulate(problem, method=...)` → RodRun.
+
+The rod is posed as a general Scene (one body, disk contacts A and B with the floor) and run by
+any integrator; this module only translates the general result into the paper's coordinates
+(x_O, θ, N and T at ball A) and the summary every method shares.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .integrators.event_driven import EventDriven, EventDrivenOptions
+from .model.rod import RodProblem
+from .results import Phase, SimulationResult
+from .rod_hypotheses import RollingHypothesis, rolling_hypothesis
+from .validation import InputError, require_positive
+
+METHODS = ("event-driven", "moreau-jean")
+TRAJECTORY_COLUMNS = ("t", "theta", "theta_dot", "theta_ddot", "x_O", "x_O_dot", "x_O_ddot", "N", "T", "mode")
+SUMMARY_SCHEMA = "nonsmooth-rod/summary/1"
+MAX_DURATION = 10.0  # s; without --t-end the run stops at ball B's impact, well before this
+
+
+@dataclass
+class RodRun:
+    problem: RodProblem
+    method: str
+    result: SimulationResult
+    table: dict  # TRAJECTORY_COLUMNS → arrays
+    phases: list[Phase]
+    impact: dict | None
+    rolling: RollingHypothesis
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def status(self) -> str:
+        return self.result.status
+
+    def summary(self) -> dict:
+        r = self.result
+        return {
+            "schema": SUMMARY_SCHEMA,
+            "params": self.problem.as_params(),
+            "method": self.method,
+            "settings": self.settings,
+            "phases": [ph.as_dict() for ph in self.phases],
+            "impact": self.impact,
+            "rolling_hypothesis": {k: self.rolling.as_dict()[k] for k in ("T_over_N_max", "t_r1", "t_r2")}
+            | {"t_max": self.rolling.t_max, "T_over_N_initial": self.rolling.T_over_N_initial},
+            "status": r.status,
+            "message": r.message,
+            "steps": int(r.steps),
+            "cpu_time_s": float(r.cpu_time_s),
+            "events": [{"t": e.t, "kind": e.kind, "contact": e.contact} for e in r.events],
+            "stats": {k: (float(v) if isinstance(v, (int, float, np.floating, np.integer)) else v)
+                      for k, v in r.stats.items()},
+        }
+
+
+def rod_table(problem: RodProblem, result: SimulationResult) -> dict:
+    """The paper's columns for ball A from the scene's centre-of-mass trajectory."""
+    tr = result.trajectory
+    (xo, _, th), (xo_dot, _, om) = problem.ball_a_coordinates(tr.q, tr.v)
+    th_dd = tr.a[:, 2]
+    xo_dd = tr.a[:, 0] + problem.xi * np.cos(th) * om**2 + problem.xi * np.sin(th) * th_dd
+    modes = np.where(tr.modes[:, 0] == "open", "flight", tr.modes[:, 0]).astype(object)
+    return {"t": tr.t, "theta": th, "theta_dot": om, "theta_ddot": th_dd, "x_O": xo, "x_O_dot": xo_dot,
+            "x_O_ddot": xo_dd, "N": tr.normal_force[:, 0], "T": tr.tangential_force[:, 0], "mode": modes}
+
+
+def _impact_of_b(problem: RodProblem, result: SimulationResult) -> dict | None:
+    for imp in result.impacts:
+        if imp.contact == "B":
+            (xo, _, th), (xo_dot, _, om) = problem.ball_a_coordinates(imp.q, imp.v_before)
+            (_, _, _), (xo_dot_after, _, om_after) = problem.ball_a_coordinates(imp.q, imp.v_after)
+            return {"t": float(imp.t), "theta": float(th), "theta_dot": float(om), "x_O": float(xo),
+                    "x_O_dot": float(xo_dot), "theta_dot_after": float(om_after),
+                    "x_O_dot_after": float(xo_dot_after),
+                    "normal_impulse_B": float(imp.normal_impulse[1]),
+                    "tangential_impulse_B": float(imp.tangential_impulse[1])}
+    return None
+
+
+def simulate(problem: RodProblem | None = None, method: str = "event-driven", *, t_end: float | None = None,
+             h: float = 1e-4, solver: str = "lemke", theta: float = 0.5, min_phase: float | None = None,
+             rtol: float = 1e-12, output_dt: float = 1e-3) -> RodRun:
+    """Simulate the paper's rod. Without `t_end` the run stops at ball B's impact."""
+    problem = problem or RodProblem.paper()
+    if method not in METHODS:
+        raise InputError(f"unknown method '{method}'; choose from: {', '.join(METHODS)}")
+    if t_end is not None:
+        require_positive("t_end", t_end)
+    stop = "B" if t_end is None else None
+    duration = MAX_DURATION if t_end is None else t_end
+    scene = problem.scene()
+    q0, v0 = problem.initial_state()
+    if method == "event-driven":
+        require_positive("rtol", rtol)
+        integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, stop_at_impact=stop,
+                                                    output_dt=output_dt))
+        settings = {"rtol": rtol, "output_dt": output_dt}
+    else:
+        from .integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+        integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, stop_at_impact=stop,
+                                                  min_phase=min_phase))
+        settings = {"h": h, "theta": theta, "solver": solver, "min_phase": integrator.options.min_phase}
+    result = integrator.run(scene, q0, v0, duration)
+    if t_end is None and result.status == "ok" and not any(i.contact == "B" for i in result.impacts):
+        result.status = "no-impact"
+        result.message = f"ball B did not strike the plane within {MAX_DURATION:g} s"
+    table = rod_table(problem, result)
+    phases = result.phases.get("A", [])
+    phases = [Phase("flight" if p.mode == "open" else p.mode, p.t_start, p.t_end) for p in phases]
+    return RodRun(problem, method, result, table, phases, _impact_of_b(problem, result),
+                  rolling_hypothesis(problem), settings)
+
+
+def scenario(phases: list[Phase]) -> str:
+    """The paper's scenario of a run from its phase sequence (used by the regime map)."""
+    modes = [p.mode for p in phases]
+    if not modes:
+        return "unknown"
+    if modes[0] != "stick":
+        return "slide-at-start"
+    if len(modes) == 1:
+        return "roll-to-impact"
+    return "roll-until-r1" if modes[1] == "slip-" else "roll-until-r2"

@@ -1,0 +1,48 @@
+"""Small pieces shared by the solver modules (not public API)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .problem import ContactSolution, PlanarFrictionProblem, contact_states
+
+
+def velocities_and_residual(W, q, lo, hi, p):
+    """u = W p + q and the `complementarity_residual`, in plain Python floats.
+
+    Same formula as `problem.complementarity_residual` (the tests check they agree); for the
+    2–4 unknowns of a step, float loops over lists beat a dozen small numpy calls.
+    ``W`` is a list of rows, ``q``, ``lo``, ``hi``, ``p`` are lists.
+    """
+    n = len(q)
+    u = [q[i] + sum(w_ij * p_j for w_ij, p_j in zip(W[i], p)) for i in range(n)]
+    residual = 0.0
+    for i in range(n // 2):
+        p_n, p_t, u_n, u_t = p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1]
+        r_n = abs(min(p_n, u_n))
+        p_n_pos = max(p_n, 0.0)
+        trial = p_t - u_t
+        low, high = lo[i] * p_n_pos, hi[i] * p_n_pos
+        projected = low if trial < low else (high if trial > high else trial)
+        residual = max(residual, r_n, abs(p_t - projected))
+    return u, residual
+
+
+def max_abs(*vectors) -> float:
+    """Max-norm over several lists of floats (0 for empty)."""
+    return max((abs(x) for v in vectors for x in v), default=0.0)
+
+
+def relative_floor(*vectors) -> float:
+    """`problem.residual_scale` on lists: the scale a relative tolerance multiplies."""
+    scale = max_abs(*vectors)
+    return scale if scale > 0.0 else 1.0
+
+
+def make_solution(
+    problem: PlanarFrictionProblem, p, u, solver: str, iterations: int, residual: float, **info
+) -> ContactSolution:
+    """ContactSolution with the per-contact states every solver reports in ``info["states"]``."""
+    p = np.asarray(p, dtype=float)
+    u = np.asarray(u, dtype=float)
+    info["states"] = contact_states(problem, p, u)
+    return ContactSolution(p=p, u=u, solver=solver, iterations=iterations, residual=residual, info=info)

@@ -1,0 +1,431 @@
+"""Lemke's complementary pivoting, for a general LCP and for the step's friction problem.
+
+General LCP:  w = M z + q,  0 ≤ w ⊥ z ≥ 0.
+
+Friction step as an LCP (``lemke_friction``). Per contact i the unknowns are
+z_i = (p_N, β, σ) with β = p_T − lo·p_N the tangential impulse measured from the lower end
+of the friction interval and σ ≥ 0 a slack that carries the magnitude of a negative slip::
+
+    w_i = ( u_N,                  ⊥  p_N ≥ 0
+            u_T + σ,              ⊥  β   ≥ 0
+            (hi − lo)·p_N − β )   ⊥  σ   ≥ 0
+
+With u = W p + q and p_T = lo·p_N + β, contact j's columns of W enter as
+(W_·N + lo_j W_·T, W_·T), which gives per block (i row, j column)::
+
+    M_ij = [[W_NN + lo_j W_NT, W_NT, 0     ],
+            [W_TN + lo_j W_TT, W_TT, δ_ij  ],
+            [δ_ij (hi_i − lo_i), −δ_ij, 0  ]],     q_i = (q_N, q_T, 0).
+
+Why this is the step law (hi > lo; for hi = lo, β = 0 and p_T = lo·p_N is forced):
+β = 0 ⇒ p_T = lo·p_N; σ > 0 would need β = (hi − lo)p_N = 0 i.e. p_N = 0, so for p_N > 0
+σ = 0 and u_T ≥ 0 (slip "+", or rest at the edge). β = (hi − lo)p_N > 0 ⇒ p_T = hi·p_N
+and u_T = −σ ≤ 0 (slip "−"). 0 < β < (hi − lo)p_N ⇒ σ = 0 and u_T = −σ = 0 (stick).
+
+The pivoting kernels are written once in plain Python (float loops over lists: faster than
+numpy calls for the 3–6 unknowns of a step) and compiled with numba when it is installed;
+``new_matrix``/``new_vector`` allocate lists in Python and numpy arrays under numba.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ._common import make_solution, relative_floor
+from .problem import NoConvergence, PlanarFrictionProblem, RayTermination
+
+try:  # numba is an optional accelerator; everything below also runs as plain Python.
+    import numba
+    from numba.extending import overload, register_jitable
+except ImportError:  # pragma: no cover - exercised only where numba is absent
+    numba = None
+
+    def register_jitable(function):
+        return function
+
+
+HAVE_NUMBA = numba is not None
+
+# Kernel status codes.
+SOLVED, RAY, PIVOT_LIMIT = 0, 1, 2
+
+# Tolerances of the pivoting, in the units of the normalised data (max |entry| of M and q = 1).
+PIVOT_TOL = 1e-12  # a column entry must exceed this (times the column's max, ≥ 1) to be a pivot
+TIE_TOL = 1e-12  # relative tolerance under which two ratios count as tied
+
+# Accept a friction solution when complementarity_residual ≤ RESIDUAL_TOL · residual_scale.
+RESIDUAL_TOL = 1e-9
+
+
+def new_matrix(rows, cols):
+    """Zero matrix: list of lists in plain Python (a numpy array under numba, see overload)."""
+    return [[0.0] * cols for _ in range(rows)]
+
+
+def new_vector(size):
+    """Zero float vector (list in plain Python, numpy array under numba)."""
+    return [0.0] * size
+
+
+def new_index(size):
+    """Index vector 0..size−1 (list in plain Python, numpy int array under numba)."""
+    return list(range(size))
+
+
+if HAVE_NUMBA:
+
+    @overload(new_matrix)
+    def _new_matrix_numba(rows, cols):
+        return lambda rows, cols: np.zeros((rows, cols))
+
+    @overload(new_vector)
+    def _new_vector_numba(size):
+        return lambda size: np.zeros(size)
+
+    @overload(new_index)
+    def _new_index_numba(size):
+        return lambda size: np.arange(size)
+
+
+@register_jitable
+def _fill_tableau(T, M, q, n):
+    """T = [I | −M | −d | q] with covering vector d = (1, …, 1); T must be zero on entry."""
+    for i in range(n):
+        row = T[i]
+        row[i] = 1.0
+        Mi = M[i]
+        for j in range(n):
+            row[n + j] = -Mi[j]
+        row[2 * n] = -1.0
+        row[2 * n + 1] = q[i]
+
+
+@register_jitable
+def _pivot(T, r, e):
+    """Gauss–Jordan pivot of tableau T on row r, column e."""
+    n_cols = len(T[0])
+    row = T[r]
+    inverse = 1.0 / row[e]
+    for j in range(n_cols):
+        row[j] *= inverse
+    row[e] = 1.0
+    for i in range(len(T)):
+        if i != r:
+            other = T[i]
+            factor = other[e]
+            if factor != 0.0:
+                for j in range(n_cols):
+                    other[j] -= factor * row[j]
+                other[e] = 0.0
+
+
+@register_jitable
+def _lex_smaller(T, i, k, e, n):
+    """Is row i's (rhs, B⁻¹ row)/T[i][e] lexicographically smaller than row k's?
+
+    B⁻¹ sits in the first n columns (the w columns, the identity at the start). Rows of
+    B⁻¹ are independent, so in exact arithmetic two rows are never lexicographically equal:
+    this is what makes the minimum-ratio choice unique and rules out cycling.
+    """
+    a_i = T[i][e]
+    a_k = T[k][e]
+    x = T[i][2 * n + 1] / a_i
+    y = T[k][2 * n + 1] / a_k
+    tol = TIE_TOL * (1.0 + abs(x) + abs(y))
+    if x < y - tol:
+        return True
+    if x > y + tol:
+        return False
+    for j in range(n):
+        x = T[i][j] / a_i
+        y = T[k][j] / a_k
+        tol = TIE_TOL * (1.0 + abs(x) + abs(y))
+        if x < y - tol:
+            return True
+        if x > y + tol:
+            return False
+    return False
+
+
+@register_jitable
+def _complementary_pivoting(T, basis, n, max_pivots):
+    """Lemke's method on tableau T = [I | −M | −d | q]; basis[i] is the variable of row i.
+
+    Variables are numbered w_0..w_{n−1} = 0..n−1, z_0..z_{n−1} = n..2n−1, z0 (artificial) = 2n.
+    Returns (status, pivots, last entering variable). On SOLVED the basic variables are in
+    basis/T[:, rhs]; q ≥ 0 returns SOLVED after 0 pivots (z = 0).
+    """
+    z0 = 2 * n
+    rhs = 2 * n + 1
+    # Entering z0 drives w up by z0·d; the row that leaves is the lexicographic minimum of
+    # (q_i, e_i): the most negative q_i, ties to the LARGEST index (e_i is lexicographically
+    # smaller for larger i).
+    r = -1
+    q_min = 0.0
+    for i in range(n):
+        value = T[i][rhs]
+        if value < 0.0:
+            if r < 0 or value <= q_min + TIE_TOL * (1.0 + abs(q_min)):
+                r = i
+                q_min = min(q_min, value)
+    if r < 0:
+        return SOLVED, 0, -1
+    if max_pivots < 1:
+        return PIVOT_LIMIT, 0, z0
+    _pivot(T, r, z0)
+    z0_row = r
+    leaving = basis[r]
+    basis[r] = z0
+    pivots = 1
+    entering = leaving + n  # complement of the w that just left
+    while True:
+        column_max = 1.0
+        for i in range(n):
+            column_max = max(column_max, abs(T[i][entering]))
+        pivot_tol = PIVOT_TOL * column_max
+        r = -1
+        for i in range(n):
+            if T[i][entering] > pivot_tol and (r < 0 or _lex_smaller(T, i, r, entering, n)):
+                r = i
+        if r < 0:
+            return RAY, pivots, entering
+        # If z0 ties for leaving, let it leave: that ends the method with a solution.
+        a0 = T[z0_row][entering]
+        if r != z0_row and a0 > pivot_tol:
+            ratio0 = T[z0_row][rhs] / a0
+            ratio = T[r][rhs] / T[r][entering]
+            if ratio0 <= ratio + TIE_TOL * (1.0 + abs(ratio)):
+                r = z0_row
+        if pivots >= max_pivots:
+            return PIVOT_LIMIT, pivots, entering
+        _pivot(T, r, entering)
+        pivots += 1
+        leaving = basis[r]
+        basis[r] = entering
+        if leaving == z0:
+            return SOLVED, pivots, entering
+        entering = leaving + n if leaving < n else leaving - n
+
+
+@register_jitable
+def _basic_solution(T, basis, M, q, n, z):
+    """z from the final basis, with one step of iterative refinement against the original M, q.
+
+    The basic values x satisfy B x = q with B's columns e_v (w_v), −M[:, c] (z_c) and −d (z0);
+    the tableau's w columns hold B⁻¹, so x += B⁻¹ (q − B x) removes most of the round-off the
+    pivots accumulated. Tiny negative values of round-off size are clipped to 0.
+    """
+    rhs = 2 * n + 1
+    residual = new_vector(n)
+    for k in range(n):
+        residual[k] = q[k]
+    for i in range(n):
+        v = basis[i]
+        x = T[i][rhs]
+        if v < n:
+            residual[v] -= x
+        elif v < 2 * n:
+            c = v - n
+            for k in range(n):
+                residual[k] += M[k][c] * x
+        else:
+            for k in range(n):
+                residual[k] += x
+    for j in range(n):
+        z[j] = 0.0
+    for i in range(n):
+        v = basis[i]
+        if n <= v < 2 * n:
+            row = T[i]
+            x = row[rhs]
+            for k in range(n):
+                x += row[k] * residual[k]
+            z[v - n] = max(x, 0.0)
+
+
+@register_jitable
+def _lemke_kernel(M, q, max_pivots):
+    """Lemke on (M, q) given as rows/vector; returns (z, status, pivots, last entering)."""
+    n = len(q)
+    T = new_matrix(n, 2 * n + 2)
+    _fill_tableau(T, M, q, n)
+    basis = new_index(n)
+    status, pivots, entering = _complementary_pivoting(T, basis, n, max_pivots)
+    z = new_vector(n)
+    if status == SOLVED:
+        _basic_solution(T, basis, M, q, n, z)
+    return z, status, pivots, entering
+
+
+@register_jitable
+def _lemke_friction_kernel(W, q, lo, hi, max_pivots):
+    """Friction step → lifted LCP (module docstring) → Lemke → (p, u, residual, status, pivots).
+
+    The LCP is built from W / max|W| and q / max|q| so that the pivoting tolerances act on
+    O(1) numbers; p = p̃ · max|q| / max|W| undoes it exactly (u scales with max|q|).
+    """
+    n_c = len(lo)
+    n = 3 * n_c
+    w_scale = 0.0
+    q_scale = 0.0
+    for i in range(2 * n_c):
+        q_scale = max(q_scale, abs(q[i]))
+        for j in range(2 * n_c):
+            w_scale = max(w_scale, abs(W[i][j]))
+    if w_scale == 0.0:
+        w_scale = 1.0
+    if q_scale == 0.0:
+        q_scale = 1.0
+    M = new_matrix(n, n)
+    qq = new_vector(n)
+    for i in range(n_c):
+        row_n = M[3 * i]
+        row_t = M[3 * i + 1]
+        W_n = W[2 * i]
+        W_t = W[2 * i + 1]
+        for j in range(n_c):
+            row_n[3 * j] = (W_n[2 * j] + lo[j] * W_n[2 * j + 1]) / w_scale
+            row_n[3 * j + 1] = W_n[2 * j + 1] / w_scale
+            row_t[3 * j] = (W_t[2 * j] + lo[j] * W_t[2 * j + 1]) / w_scale
+            row_t[3 * j + 1] = W_t[2 * j + 1] / w_scale
+        row_t[3 * i + 2] = 1.0
+        M[3 * i + 2][3 * i] = hi[i] - lo[i]
+        M[3 * i + 2][3 * i + 1] = -1.0
+        qq[3 * i] = q[2 * i] / q_scale
+        qq[3 * i + 1] = q[2 * i + 1] / q_scale
+    z, status, pivots, entering = _lemke_kernel(M, qq, max_pivots)
+
+    p = new_vector(2 * n_c)
+    u = new_vector(2 * n_c)
+    residual = 0.0
+    if status == SOLVED:
+        to_impulse = q_scale / w_scale
+        for j in range(n_c):
+            p[2 * j] = z[3 * j] * to_impulse
+            p[2 * j + 1] = (lo[j] * z[3 * j] + z[3 * j + 1]) * to_impulse
+        # u = W p + q and complementarity_residual (same formula as problem.py).
+        for i in range(2 * n_c):
+            value = q[i]
+            W_i = W[i]
+            for j in range(2 * n_c):
+                value += W_i[j] * p[j]
+            u[i] = value
+        for i in range(n_c):
+            p_n = p[2 * i]
+            p_t = p[2 * i + 1]
+            r_n = abs(min(p_n, u[2 * i]))
+            p_n_pos = max(p_n, 0.0)
+            trial = p_t - u[2 * i + 1]
+            low = lo[i] * p_n_pos
+            high = hi[i] * p_n_pos
+            projected = low if trial < low else (high if trial > high else trial)
+            residual = max(residual, r_n, abs(p_t - projected))
+    return p, u, residual, status, pivots
+
+
+if HAVE_NUMBA:
+    _lemke_kernel_jit = numba.njit(cache=True)(_lemke_kernel)
+    _lemke_friction_kernel_jit = numba.njit(cache=True)(_lemke_friction_kernel)
+
+
+def _default_max_pivots(n: int) -> int:
+    # Lemke typically needs O(n) pivots; exponential worst cases do not occur at n ≤ 12.
+    return 50 + 20 * n
+
+
+def _variable_name(index: int, n: int) -> str:
+    if index < 0:
+        return "none"
+    if index < n:
+        return f"w{index}"
+    if index < 2 * n:
+        return f"z{index - n}"
+    return "z0"
+
+
+def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
+    """Solve w = M z + q, 0 ≤ w ⊥ z ≥ 0 by Lemke's method; return (z, pivots).
+
+    Covering vector d = (1, …, 1); lexicographic minimum-ratio rule (no cycling on degenerate
+    problems); q ≥ 0 returns z = 0 after 0 pivots. M and q are normalised to max|entry| = 1
+    before pivoting (the solution scales back exactly). ``jit``: use the numba kernel (default:
+    when numba is installed).
+
+    Raises RayTermination on a secondary ray (no solution found by complementary pivoting:
+    the LCP may be infeasible, or M outside the classes Lemke is guaranteed to process) and
+    NoConvergence when ``max_pivots`` (default 50 + 20 n) is reached.
+    """
+    M = np.array(M, dtype=float, ndmin=2)
+    q = np.array(q, dtype=float, ndmin=1)
+    n = q.shape[0]
+    if M.shape != (n, n):
+        raise ValueError(f"lemke: M must be {n}×{n} for q of length {n}, got {M.shape}")
+    if max_pivots is None:
+        max_pivots = _default_max_pivots(n)
+    m_scale = float(np.max(np.abs(M), initial=0.0)) or 1.0
+    q_scale = float(np.max(np.abs(q), initial=0.0)) or 1.0
+    M_scaled, q_scaled = M / m_scale, q / q_scale
+    if _use_jit(jit):
+        z, status, pivots, entering = _lemke_kernel_jit(M_scaled, q_scaled, max_pivots)
+    else:
+        z, status, pivots, entering = _lemke_kernel(M_scaled.tolist(), q_scaled.tolist(), max_pivots)
+    if status == RAY:
+        raise RayTermination(
+            f"lemke: secondary ray after {pivots} pivots (entering {_variable_name(entering, n)} "
+            f"has no positive entry in its column) on an LCP of size {n}: no solution reached"
+        )
+    if status == PIVOT_LIMIT:
+        raise NoConvergence(f"lemke: pivot limit {max_pivots} reached on an LCP of size {n}")
+    return np.asarray(z, dtype=float) * (q_scale / m_scale), pivots
+
+
+def _use_jit(jit: bool | None) -> bool:
+    if jit is None:
+        return HAVE_NUMBA
+    if jit and not HAVE_NUMBA:
+        raise ValueError("jit=True needs numba, which is not installed")
+    return jit
+
+
+def lemke_friction(
+    problem: PlanarFrictionProblem,
+    *,
+    max_pivots: int | None = None,
+    tol: float = RESIDUAL_TOL,
+    jit: bool | None = None,
+):
+    """Solve the step's friction problem exactly as the lifted LCP (module docstring) by Lemke.
+
+    Returns a ContactSolution (iterations = pivots). Raises RayTermination / NoConvergence as
+    ``lemke`` does, and NoConvergence if the recovered impulses miss the step law:
+    complementarity_residual > tol · residual_scale (round-off only, normally ~1e-16).
+    """
+    n_c = problem.n_contacts
+    if max_pivots is None:
+        max_pivots = _default_max_pivots(3 * n_c)
+    if _use_jit(jit):
+        p, u, residual, status, pivots = _lemke_friction_kernel_jit(
+            problem.W, problem.q, problem.lo, problem.hi, max_pivots
+        )
+    else:
+        p, u, residual, status, pivots = _lemke_friction_kernel(
+            problem.W.tolist(), problem.q.tolist(), problem.lo.tolist(), problem.hi.tolist(), max_pivots
+        )
+    if status == RAY:
+        raise RayTermination(
+            f"lemke: secondary ray after {pivots} pivots on the friction LCP of {n_c} contact(s) "
+            f"(size {3 * n_c}): no solution reached"
+        )
+    if status == PIVOT_LIMIT:
+        raise NoConvergence(
+            f"lemke: pivot limit {max_pivots} reached on the friction LCP of {n_c} contact(s)"
+        )
+    scale = relative_floor(p, u, problem.q)
+    if not residual <= tol * scale:
+        raise NoConvergence(
+            f"lemke: solution after {pivots} pivots misses the step law, residual {residual:.3e} "
+            f"> {tol:.0e} × scale {scale:.3e}"
+        )
+    return make_solution(problem, p, u, "lemke", pivots, residual)
+
+
+__all__ = ["lemke", "lemke_friction", "HAVE_NUMBA"]
