@@ -6,6 +6,7 @@ Every mistake in the input ends with one line on stderr and exit status 2; a run
 from __future__ import annotations
 
 import argparse
+import importlib
 import math
 import sys
 from pathlib import Path
@@ -14,6 +15,7 @@ from . import __version__
 from .validation import InputError
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+STUDY_COMMANDS = ("plot", "sweep", "benchmark")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -75,6 +77,11 @@ def build_problem(args):
     return RodProblem.from_geometry(geo, **common)
 
 
+def add_physics_options(parser: argparse.ArgumentParser) -> None:
+    """The rod's physical options, shared by every command that builds a RodProblem."""
+    _add_physics(parser)
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="nonsmooth-rod", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"nonsmooth-rod {__version__}")
@@ -97,6 +104,17 @@ def make_parser() -> argparse.ArgumentParser:
     out.add_argument("--json", action="store_true", help="print the summary JSON on stdout and nothing else there")
     out.add_argument("--no-plot", action="store_true", help="do not write figure.png")
     out.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    sim.set_defaults(handler=cmd_simulate)
+    # The other studies live in nonsmooth_rod.commands.<name>: each module offers
+    # register(subparsers) and sets its own handler.
+    for name in STUDY_COMMANDS:
+        try:
+            module = importlib.import_module(f"nonsmooth_rod.commands.{name}")
+        except ModuleNotFoundError as err:
+            if err.name != f"nonsmooth_rod.commands.{name}":
+                raise
+            continue
+        module.register(sub)
     return parser
 
 
@@ -161,7 +179,7 @@ def main(argv=None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_BAD_INPUT
-        return {"simulate": cmd_simulate}[args.command](args)
+        return args.handler(args)
     except InputError as err:
         print(f"nonsmooth-rod: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -104,8 +104,19 @@ class MoreauJean:
             kin = scene.kinematics(qk, vk)
             f = scene.force(t + th * h, qk, vk)
             v_free = vk + h * minv * f
-            active = [i for i, c in enumerate(kin)
-                      if c.gap + opts.activation_gamma * h * float(c.H_N @ vk) <= 0.0]
+            # A contact enters the step when its predicted gap closes. A contact that acted in
+            # the previous step stays while its predicted gap is within the gap change one step
+            # of its own acceleration can cause (h² |g̈|): the velocity-level law lets a resting
+            # contact's gap wander by that much, and dropping it for one step would insert a
+            # spurious free-flight step (and a wrong slip guess) into a rolling phase.
+            active = []
+            for i, c in enumerate(kin):
+                predicted = c.gap + opts.activation_gamma * h * float(c.H_N @ vk)
+                margin = 0.0
+                if was_closed[i]:
+                    margin = h * h * (abs(c.drift_N) + abs(float(c.H_N @ (minv * f))))
+                if predicted <= margin:
+                    active.append(i)
             if active:
                 H = np.empty((2 * len(active), n_dof))
                 q_step = np.empty(2 * len(active))
@@ -113,8 +124,15 @@ class MoreauJean:
                 for j, i in enumerate(active):
                     c = kin[i]
                     H[2 * j], H[2 * j + 1] = c.H_N, c.H_T
-                    u_N_k = float(c.H_N @ vk)
-                    q_step[2 * j] = float(c.H_N @ v_free) + rest[i] * min(u_N_k, 0.0)
+                    if was_closed[i]:
+                        # A persistent contact keeps its gap, not only its normal velocity, at
+                        # zero: the Jacobian turns with the body within the step, so a purely
+                        # velocity-level law lets the gap creep by O(h) per unit time (then the
+                        # contact drops out and re-impacts). Asking u_N ≥ −g/h removes the creep.
+                        q_step[2 * j] = float(c.H_N @ v_free) + c.gap / h
+                    else:
+                        u_N_k = float(c.H_N @ vk)
+                        q_step[2 * j] = float(c.H_N @ v_free) + rest[i] * min(u_N_k, 0.0)
                     q_step[2 * j + 1] = float(c.H_T @ v_free) - c.surface_velocity
                     if was_closed[i]:
                         guess[j] = slip_sign[i]
@@ -176,20 +194,26 @@ class MoreauJean:
 
     @staticmethod
     def _crossing_time(scene, kin, f, vk, t, h) -> float:
-        """When the contact's gap crosses zero inside the step: root of g + u τ + ½ a τ²."""
+        """When the contact's gap crossed zero: the root of g + u τ + ½ a τ² nearest the step.
+
+        The contact may enter the problem a little before (predicted gap) or after (closing in
+        the second half of the previous step) the geometric crossing, so τ ∈ [−h, 2h].
+        """
         g = kin.gap
         u = float(kin.H_N @ vk)
         a = float(kin.H_N @ (scene.inverse_mass_diagonal * f)) + kin.drift_N
-        if g <= 0.0:
-            return t
+        roots = []
         if abs(a) > 1e-14:
             disc = u * u - 2.0 * a * g
             if disc >= 0.0:
-                roots = [(-u - math.sqrt(disc)) / a, (-u + math.sqrt(disc)) / a]
-                roots = [r for r in roots if r >= 0.0]
-                if roots:
-                    return t + min(min(roots), 2 * h)
-        return t + min(g / -u, 2 * h)
+                sq = math.sqrt(disc)
+                roots = [(-u - sq) / a, (-u + sq) / a]
+        elif u != 0.0:
+            roots = [-g / u]
+        roots = [r for r in roots if -h <= r <= 2 * h]
+        if not roots:
+            return t
+        return t + min(roots, key=abs)
 
     def _result(self, scene, q, v, pN, pT, states, n_done, h, names, events, impacts, status, message,
                 cpu, t_stop, stats) -> SimulationResult:

@@ -47,6 +47,9 @@ HAVE_NUMBA = numba is not None
 
 # Kernel status codes.
 SOLVED, RAY, PIVOT_LIMIT = 0, 1, 2
+# Friction LCP formulations.
+INTERVAL, CONE = 0, 1
+FORMULATIONS = {"interval": INTERVAL, "cone": CONE}
 
 # Tolerances of the pivoting, in the units of the normalised data (max |entry| of M and q = 1).
 PIVOT_TOL = 1e-12  # a column entry must exceed this (times the column's max, ≥ 1) to be a pivot
@@ -257,26 +260,9 @@ def _lemke_kernel(M, q, max_pivots):
 
 
 @register_jitable
-def _lemke_friction_kernel(W, q, lo, hi, max_pivots):
-    """Friction step → lifted LCP (module docstring) → Lemke → (p, u, residual, status, pivots).
-
-    The LCP is built from W / max|W| and q / max|q| so that the pivoting tolerances act on
-    O(1) numbers; p = p̃ · max|q| / max|W| undoes it exactly (u scales with max|q|).
-    """
+def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
+    """The 3-per-contact LCP of the module docstring, from W / w_scale and q / q_scale."""
     n_c = len(lo)
-    n = 3 * n_c
-    w_scale = 0.0
-    q_scale = 0.0
-    for i in range(2 * n_c):
-        q_scale = max(q_scale, abs(q[i]))
-        for j in range(2 * n_c):
-            w_scale = max(w_scale, abs(W[i][j]))
-    if w_scale == 0.0:
-        w_scale = 1.0
-    if q_scale == 0.0:
-        q_scale = 1.0
-    M = new_matrix(n, n)
-    qq = new_vector(n)
     for i in range(n_c):
         row_n = M[3 * i]
         row_t = M[3 * i + 1]
@@ -292,6 +278,69 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots):
         M[3 * i + 2][3 * i + 1] = -1.0
         qq[3 * i] = q[2 * i] / q_scale
         qq[3 * i + 1] = q[2 * i + 1] / q_scale
+
+
+@register_jitable
+def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
+    """The 4-per-contact (Anitescu–Potra) LCP of the module docstring, scaled likewise."""
+    n_c = len(lo)
+    for i in range(n_c):
+        row_n = M[4 * i]
+        row_hi = M[4 * i + 1]
+        row_lo = M[4 * i + 2]
+        W_n = W[2 * i]
+        W_t = W[2 * i + 1]
+        for j in range(n_c):
+            # columns of z_j = (p_N, b_hi, b_lo, λ) in u-space: W_·N, hi_j W_·T, lo_j W_·T, 0
+            row_n[4 * j] = W_n[2 * j] / w_scale
+            row_n[4 * j + 1] = hi[j] * W_n[2 * j + 1] / w_scale
+            row_n[4 * j + 2] = lo[j] * W_n[2 * j + 1] / w_scale
+            u_t_pn = W_t[2 * j] / w_scale
+            u_t_pt = W_t[2 * j + 1] / w_scale
+            row_hi[4 * j] = hi[i] * u_t_pn
+            row_hi[4 * j + 1] = hi[i] * hi[j] * u_t_pt
+            row_hi[4 * j + 2] = hi[i] * lo[j] * u_t_pt
+            row_lo[4 * j] = lo[i] * u_t_pn
+            row_lo[4 * j + 1] = lo[i] * hi[j] * u_t_pt
+            row_lo[4 * j + 2] = lo[i] * lo[j] * u_t_pt
+        row_hi[4 * i + 3] = 1.0
+        row_lo[4 * i + 3] = 1.0
+        row_gap = M[4 * i + 3]
+        row_gap[4 * i] = 1.0
+        row_gap[4 * i + 1] = -1.0
+        row_gap[4 * i + 2] = -1.0
+        qq[4 * i] = q[2 * i] / q_scale
+        qq[4 * i + 1] = hi[i] * q[2 * i + 1] / q_scale
+        qq[4 * i + 2] = lo[i] * q[2 * i + 1] / q_scale
+
+
+@register_jitable
+def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
+    """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots).
+
+    ``formulation``: INTERVAL (3 unknowns per contact) or CONE (4 per contact). The LCP is
+    built from W / max|W| and q / max|q| so that the pivoting tolerances act on O(1)
+    numbers; p = p̃ · max|q| / max|W| undoes it exactly (u scales with max|q|).
+    """
+    n_c = len(lo)
+    w_scale = 0.0
+    q_scale = 0.0
+    for i in range(2 * n_c):
+        q_scale = max(q_scale, abs(q[i]))
+        for j in range(2 * n_c):
+            w_scale = max(w_scale, abs(W[i][j]))
+    if w_scale == 0.0:
+        w_scale = 1.0
+    if q_scale == 0.0:
+        q_scale = 1.0
+    per_contact = 3 if formulation == INTERVAL else 4
+    n = per_contact * n_c
+    M = new_matrix(n, n)
+    qq = new_vector(n)
+    if formulation == INTERVAL:
+        _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
+    else:
+        _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
     z, status, pivots, entering = _lemke_kernel(M, qq, max_pivots)
 
     p = new_vector(2 * n_c)
@@ -300,8 +349,12 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots):
     if status == SOLVED:
         to_impulse = q_scale / w_scale
         for j in range(n_c):
-            p[2 * j] = z[3 * j] * to_impulse
-            p[2 * j + 1] = (lo[j] * z[3 * j] + z[3 * j + 1]) * to_impulse
+            k = per_contact * j
+            p[2 * j] = z[k] * to_impulse
+            if formulation == INTERVAL:
+                p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
+            else:
+                p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
         # u = W p + q and complementarity_residual (same formula as problem.py).
         for i in range(2 * n_c):
             value = q[i]
@@ -386,38 +439,45 @@ def _use_jit(jit: bool | None) -> bool:
     return jit
 
 
+def _run_friction_kernel(problem, formulation, max_pivots, jit):
+    code = FORMULATIONS[formulation]
+    if max_pivots is None:
+        max_pivots = _default_max_pivots((3 if code == INTERVAL else 4) * problem.n_contacts)
+    if jit:
+        return _lemke_friction_kernel_jit(problem.W, problem.q, problem.lo, problem.hi, max_pivots, code)
+    return _lemke_friction_kernel(
+        problem.W.tolist(), problem.q.tolist(), problem.lo.tolist(), problem.hi.tolist(), max_pivots, code
+    )
+
+
 def lemke_friction(
     problem: PlanarFrictionProblem,
     *,
+    formulation: str = "interval",
     max_pivots: int | None = None,
     tol: float = RESIDUAL_TOL,
     jit: bool | None = None,
 ):
-    """Solve the step's friction problem exactly as the lifted LCP (module docstring) by Lemke.
+    """Solve the step's friction problem exactly as a lifted LCP (module docstring) by Lemke.
 
+    ``formulation``: "interval" (3 unknowns per contact) or "cone" (4 per contact).
     Returns a ContactSolution (iterations = pivots). Raises RayTermination / NoConvergence as
     ``lemke`` does, and NoConvergence if the recovered impulses miss the step law:
     complementarity_residual > tol · residual_scale (round-off only, normally ~1e-16).
     """
+    if formulation not in FORMULATIONS:
+        raise ValueError(f"lemke: unknown formulation {formulation!r}; choose from {sorted(FORMULATIONS)}")
     n_c = problem.n_contacts
-    if max_pivots is None:
-        max_pivots = _default_max_pivots(3 * n_c)
-    if _use_jit(jit):
-        p, u, residual, status, pivots = _lemke_friction_kernel_jit(
-            problem.W, problem.q, problem.lo, problem.hi, max_pivots
-        )
-    else:
-        p, u, residual, status, pivots = _lemke_friction_kernel(
-            problem.W.tolist(), problem.q.tolist(), problem.lo.tolist(), problem.hi.tolist(), max_pivots
-        )
+    p, u, residual, status, pivots = _run_friction_kernel(problem, formulation, max_pivots, _use_jit(jit))
+    size = (3 if formulation == "interval" else 4) * n_c
     if status == RAY:
         raise RayTermination(
-            f"lemke: secondary ray after {pivots} pivots on the friction LCP of {n_c} contact(s) "
-            f"(size {3 * n_c}): no solution reached"
+            f"lemke: secondary ray after {pivots} pivots on the {formulation} friction LCP of "
+            f"{n_c} contact(s) (size {size}): no solution reached"
         )
     if status == PIVOT_LIMIT:
         raise NoConvergence(
-            f"lemke: pivot limit {max_pivots} reached on the friction LCP of {n_c} contact(s)"
+            f"lemke: pivot limit {pivots} reached on the {formulation} friction LCP of {n_c} contact(s)"
         )
     scale = relative_floor(p, u, problem.q)
     if not residual <= tol * scale:
@@ -425,7 +485,7 @@ def lemke_friction(
             f"lemke: solution after {pivots} pivots misses the step law, residual {residual:.3e} "
             f"> {tol:.0e} × scale {scale:.3e}"
         )
-    return make_solution(problem, p, u, "lemke", pivots, residual)
+    return make_solution(problem, p, u, "lemke", pivots, residual, formulation=formulation)
 
 
 __all__ = ["lemke", "lemke_friction", "HAVE_NUMBA"]

@@ -1,0 +1,1 @@
+"""Subcommands of the nonsmooth-rod CLI besides simulate: each module has register(subparsers)."""
