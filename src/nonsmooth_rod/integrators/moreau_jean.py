@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.scene import Scene
+from . import fast_moreau_jean
 from ..onestep import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..solvers import available_solvers
@@ -44,6 +45,7 @@ class MoreauJeanOptions:
     stop_at_impact: str | None = None  # name of a contact whose first impact ends the run
     min_phase: float | None = None  # phases shorter than this are merged (default 2h)
     allow_energy_gain: bool = False  # θ < ½ amplifies energy; refused unless asked for
+    fast: bool = True  # use the compiled loop when the scene and solver allow it
 
     def __post_init__(self):
         require_positive("h (step size)", self.h)
@@ -82,6 +84,8 @@ class MoreauJean:
         mu_d = np.array([c.law.friction.mu_d for c in scene.contacts])
         rest = np.array([c.law.impact.restitution for c in scene.contacts])
         stop_index = names.index(opts.stop_at_impact) if opts.stop_at_impact in names else None
+        if opts.fast and fast_moreau_jean.eligible(scene, opts.solver):
+            return self._run_compiled(scene, q0, v0, n_steps, stop_index, names, t_end)
 
         q = np.empty((n_steps + 1, n_dof))
         v = np.empty((n_steps + 1, n_dof))
@@ -190,7 +194,7 @@ class MoreauJean:
                             status, message, cpu, t_stop,
                             {"solves": solves, "solver_iterations": iterations,
                              "inconsistent_steps": inconsistent, "h": h, "theta": th,
-                             "solver": opts.solver})
+                             "solver": opts.solver, "compiled": False})
 
     @staticmethod
     def _crossing_time(scene, kin, f, vk, t, h) -> float:
@@ -214,6 +218,45 @@ class MoreauJean:
         if not roots:
             return t
         return t + min(roots, key=abs)
+
+    def _run_compiled(self, scene, q0, v0, n_steps, stop_index, names, t_end) -> SimulationResult:
+        opts = self.options
+        wall = time.process_time()
+        (q, v, pN, pT, states, n_done, code, fail_step, impact_t, impact_step, t_stop, solves,
+         inconsistent) = fast_moreau_jean.run_compiled(scene, q0, v0, opts.h, opts.theta, opts.activation_gamma,
+                                                       n_steps, -1 if stop_index is None else stop_index)
+        cpu = time.process_time() - wall
+        h = opts.h
+        events, impacts = [], []
+        minv = scene.inverse_mass_diagonal
+        f = scene.force(0.0, q[0], v[0])
+        for i in np.argsort(impact_t):
+            k = int(impact_step[i])
+            if k < 0 or k >= n_done:
+                continue
+            t_hit = float(impact_t[i])
+            v_hit = v[k] + (t_hit - k * h) * minv * f
+            q_hit = q[k] + (t_hit - k * h) * v[k]
+            impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v[k + 1].copy(), pN[k].copy(), pT[k].copy()))
+            events.append(Event(t_hit, "impact", names[i], {"step": k}))
+        status, message = "ok", f"reached t_end = {t_end:g} s"
+        t_stop = None if math.isnan(t_stop) else float(t_stop)
+        if t_stop is not None:
+            message = f"stopped at the impact of {opts.stop_at_impact}"
+        if code == fast_moreau_jean.RUN_SOLVER_FAILED:
+            k = int(fail_step)
+            state_txt = ", ".join(f"{names[i]}:{STATE_NAMES[states[k - 1, i]] if k else 'initial'}"
+                                  for i in range(len(names)))
+            status = "failed"
+            message = (f"lemke: no valid solution of the step problem (step {k}, t = {k * h:.9g} s, "
+                       f"contact states {state_txt}, q = {np.array2string(q[k], precision=6)})")
+            events.append(Event(k * h, "solver-failure", "", {"message": message}))
+        elif code == fast_moreau_jean.RUN_NONFINITE:
+            status, message = "failed", f"non-finite state at step {fail_step}, t = {fail_step * h:.9g} s"
+        return self._result(scene, q, v, pN, pT, states, int(n_done), h, names, events, impacts, status,
+                            message, cpu, t_stop,
+                            {"solves": int(solves), "inconsistent_steps": int(inconsistent), "h": h,
+                             "theta": opts.theta, "solver": opts.solver, "compiled": True})
 
     def _result(self, scene, q, v, pN, pT, states, n_done, h, names, events, impacts, status, message,
                 cpu, t_stop, stats) -> SimulationResult:
