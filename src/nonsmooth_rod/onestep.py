@@ -8,7 +8,8 @@ the single-valued part is the shift c = (μs − μd) s of the friction interval
 
 which keeps the step an ordinary LCP (PlanarFrictionProblem). The guess is then checked against
 the slip velocity the step produced, and the step is solved again with the corrected signs
-until the impulses obey the exact law at the end-of-step velocity:
+(a wrong slip sign first falls back to 0, the ordinary μs problem, and only then to the sign
+the contact slid with) until the impulses obey the exact law at the end-of-step velocity:
 
     u_T > 0 ⇒ p_T = −μd p_N,   u_T < 0 ⇒ p_T = +μd p_N,   u_T = 0 ⇒ |p_T| ≤ μs p_N.
 
@@ -96,10 +97,13 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
         if ok.all():
             return best
+        # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
+        # tried first); only a contact that slides even then takes the sign it slid with.
+        # Jumping straight from one slip sign to the other could skip an admissible stick.
         new_guess = guess.copy()
         for i in range(len(guess)):
             if not ok[i]:
-                new_guess[i] = implied[i]
+                new_guess[i] = 0.0 if guess[i] != 0.0 else implied[i]
         if tuple(new_guess) in tried:
             break
         guess = new_guess

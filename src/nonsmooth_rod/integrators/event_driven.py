@@ -55,9 +55,10 @@ class EventDrivenOptions:
 
 
 class _Stop(Exception):
-    def __init__(self, status, message):
+    def __init__(self, status, message, detail=None):
         self.status = status
         self.message = message
+        self.detail = detail or {}
 
 
 @dataclass
@@ -149,11 +150,13 @@ class EventDriven:
                     f"no consistent contact mode at t = {t:.12g} s (modes tried from {candidates}): "
                     "the sliding problem has no solution here (Painlevé-type inconsistency)")
 
-    def _event_functions(self, scene, modes):
+    def _event_functions(self, scene, modes, q0=None, v0=None):
         """Event functions of the current mode, with what each one means."""
         funcs, meanings = [], []
         opts = self.options
         n_dof = scene.n_dof
+        start_gaps = ([k.gap for k in scene.kinematics(q0, v0)] if q0 is not None
+                      else [math.inf] * len(modes))
 
         def split(y):
             return y[:n_dof], y[n_dof:]
@@ -163,6 +166,19 @@ class EventDriven:
             contact = scene.contacts[i]
 
             if mode == "open":
+                if start_gaps[i] <= opts.gap_tol:
+                    # A flight that starts at the line (a rebound) starts a few ulps above,
+                    # on or below it: a short hop then crosses zero twice within one integrator
+                    # step, or "crosses" at the start, and the touchdown is missed (the body
+                    # falls through) or found at once. Watch for the apex first; from there
+                    # the touchdown is a single, detectable crossing.
+                    def apex_event(t, y, contact=contact):
+                        q, v = split(y)
+                        return float(contact.kinematics(q, v, n_dof).H_N @ v)
+                    apex_event.terminal, apex_event.direction = True, -1
+                    funcs.append(apex_event)
+                    meanings.append(("apex", i))
+                    continue
                 def gap_event(t, y, contact=contact):
                     q, v = split(y)
                     return contact.kinematics(q, v, n_dof).gap
@@ -239,6 +255,24 @@ class EventDriven:
             pN[i], pT[i] = res.p[2 * j], res.p[2 * j + 1]
         return v_after, pN, pT
 
+    def _check_accumulation(self, scene, t, q, v, i):
+        """Stop with "zeno" when a rebound cannot leave the contact tolerance band: the next
+        impacts would follow within it, ever closer (an accumulation point). The accumulation
+        time of the remaining geometric series of hops is reported (exact for one contact
+        under a constant force)."""
+        contact = scene.contacts[i]
+        k = contact.kinematics(q, v, scene.n_dof)
+        u = float(k.H_N @ v)
+        a = float(k.H_N @ (scene.inverse_mass_diagonal * scene.force(t, q, v))) + k.drift_N
+        if u <= self.options.velocity_tol or a >= 0.0 or u * u / (-2.0 * a) > self.options.gap_tol:
+            return
+        e = contact.law.impact.restitution
+        t_acc = t + (2.0 * u / -a) / (1.0 - e) if e < 1.0 else math.inf
+        raise _Stop("zeno", f"impacts of {contact.name} accumulate at t = {t_acc:.12g} s (Zeno): the rebound "
+                            f"at t = {t:.12g} s ({u:.3g} m/s) stays within the contact tolerance; the "
+                            "event-driven scheme cannot pass an accumulation point",
+                    {"t_accumulation": t_acc})
+
     # ------------------------------------------------------------------ main loop
     def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
         require_positive("t_end", t_end)
@@ -271,7 +305,7 @@ class EventDriven:
                 if n_events > opts.max_events:
                     raise _Stop("too-many-events", f"more than {opts.max_events} events before t = {t:.6g} s")
                 y0 = np.concatenate([q, v])
-                funcs, meanings = self._event_functions(scene, modes)
+                funcs, meanings = self._event_functions(scene, modes, q, v)
                 frozen = list(modes)
 
                 def rhs(tt, y):
@@ -310,6 +344,9 @@ class EventDriven:
                     break
                 kind, i = meanings[which]
                 forced = {}
+                if kind == "apex":
+                    modes = self._decide(scene, t, q, v)
+                    continue
                 if kind == "painleve":
                     raise _Stop("painleve",
                                 f"Painlevé configuration at t = {t:.12g} s: sliding of contact {names[i]} "
@@ -339,13 +376,14 @@ class EventDriven:
                     if opts.stop_at_impact == names[i]:
                         status, message = "ok", f"stopped at the impact of {names[i]}"
                         break
+                    self._check_accumulation(scene, t, q, v, i)
                 new_modes = self._decide(scene, t, q, v, forced)
                 if kind == "slip-zero":
                     events[-1].detail["to"] = new_modes[i]
                 modes = new_modes
         except _Stop as stop:
             status, message = stop.status, stop.message
-            events.append(Event(t, status, "", {"message": message}))
+            events.append(Event(t, status, "", {"message": message, **stop.detail}))
         traj = self._trajectory(scene, samples_t, samples_y, samples_modes)
         phases = {}
         if len(boundaries) > 1:

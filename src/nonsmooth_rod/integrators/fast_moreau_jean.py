@@ -100,17 +100,21 @@ def _attempt(W, qv, mu_s, mu_d, guess, v_tol):
         shift = (mu_s[jj] - mu_d[jj]) * guess[jj]
         lo[jj] = shift - mu_s[jj]
         hi[jj] = shift + mu_s[jj]
-    p, u, residual, kstat, pivots = _lemke_friction_kernel_jit(W, qv, lo, hi, _default_max_pivots(3 * na), INTERVAL)
-    if kstat != SOLVED:
-        p, u, residual, kstat, pivots = _lemke_friction_kernel_jit(W, qv, lo, hi, _default_max_pivots(4 * na), CONE)
+    # As solvers.lemke.lemke_friction: the interval LCP, and the cone LCP if that one fails
+    # (ray, pivot limit, or a residual above tolerance).
+    accepted = False
+    p, u, residual, kstat, pivots, norms = _lemke_friction_kernel_jit(
+        W, qv, lo, hi, _default_max_pivots(3 * na), INTERVAL)
+    scale = norms[2] if norms[2] > 0.0 else 1.0
+    accepted = kstat == SOLVED and residual <= RESIDUAL_TOL * scale
+    if not accepted:
+        p, u, residual, kstat, pivots, norms = _lemke_friction_kernel_jit(
+            W, qv, lo, hi, _default_max_pivots(4 * na), CONE)
+        scale = norms[2] if norms[2] > 0.0 else 1.0
+        accepted = kstat == SOLVED and residual <= RESIDUAL_TOL * scale
     st = np.zeros(na, dtype=np.int8)
     new_guess = guess.copy()
-    scale = 0.0
-    for r_ in range(m):
-        scale = max(scale, abs(p[r_]), abs(u[r_]), abs(qv[r_]))
-    if scale == 0.0:
-        scale = 1.0
-    if kstat != SOLVED or not residual <= RESIDUAL_TOL * scale:
+    if not accepted:
         return False, p, u, st, False, new_guess
     scale_p = 1e-300
     for r_ in range(m):
@@ -125,21 +129,24 @@ def _attempt(W, qv, mu_s, mu_d, guess, v_tol):
             st[jj] = STATE_SLIP_PLUS
             if guess[jj] != 1.0:
                 ok_all = False
-                new_guess[jj] = 1.0
+                new_guess[jj] = 0.0 if guess[jj] != 0.0 else 1.0
         elif ut < -v_tol:
             st[jj] = STATE_SLIP_MINUS
             if guess[jj] != -1.0:
                 ok_all = False
-                new_guess[jj] = -1.0
+                new_guess[jj] = 0.0 if guess[jj] != 0.0 else -1.0
         else:
             st[jj] = STATE_STICK
             if abs(pt) > mu_s[jj] * pn * (1 + 1e-9) + p_tol:
                 ok_all = False
-                new_guess[jj] = -1.0 if pt > 0 else (1.0 if pt < 0 else 0.0)
+                if guess[jj] != 0.0:
+                    new_guess[jj] = 0.0
+                else:
+                    new_guess[jj] = -1.0 if pt > 0 else (1.0 if pt < 0 else 0.0)
     return True, p, u, st, ok_all, new_guess
 
 
-def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index):
+def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIVATION_ROUNDOFF):
     n_dof = q0.shape[0]
     nc = table.shape[0]
     q = np.empty((n_steps + 1, n_dof))
@@ -180,7 +187,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index):
             H_T[i, :] = 0.0
             gaps[i], drifts[i] = _kinematics(table, i, qk, vk, H_N[i], H_T[i])
             predicted = gaps[i] + gamma * h * _dot(H_N[i], vk)
-            margin = 0.0
+            margin = ACTIVATION_ROUNDOFF
             if was_closed[i]:
                 margin = h * h * (abs(drifts[i]) + abs(_dot(H_N[i], a_free)))
             if predicted <= margin:
@@ -201,7 +208,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index):
                 H[2 * jj] = H_N[i]
                 H[2 * jj + 1] = H_T[i]
                 if was_closed[i]:
-                    qv[2 * jj] = _dot(H_N[i], v_free) + gaps[i] / h
+                    qv[2 * jj] = _dot(H_N[i], v_free) + max(gaps[i], 0.0) / h
                     guess[jj] = slip_sign[i]
                 else:
                     u_n_k = _dot(H_N[i], vk)
@@ -328,7 +335,8 @@ if AVAILABLE:
 
 def run_compiled(scene, q0, v0, h, theta, gamma, n_steps, stop_index):
     """Run the compiled loop; returns the tuple of arrays of `_run`."""
+    from .moreau_jean import ACTIVATION_ROUNDOFF
     table = pack_contacts(scene)
     force = scene.force(0.0, np.asarray(q0, float), np.asarray(v0, float))
     return _run_jit(np.asarray(q0, float), np.asarray(v0, float), scene.inverse_mass_diagonal, force, table,
-                    float(h), float(theta), float(gamma), int(n_steps), int(stop_index))
+                    float(h), float(theta), float(gamma), int(n_steps), int(stop_index), ACTIVATION_ROUNDOFF)

@@ -29,6 +29,9 @@ from ..solvers import available_solvers
 from ..solvers.problem import SolverError
 from ..validation import InputError, require_in_range, require_positive
 
+# Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
+# of a few ulps either side of zero, and must not be left out of the step for that.
+ACTIVATION_ROUNDOFF = 1e-12
 STATE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
 STATE_NAMES = ("open", "stick", "slip+", "slip-")
 
@@ -116,7 +119,7 @@ class MoreauJean:
             active = []
             for i, c in enumerate(kin):
                 predicted = c.gap + opts.activation_gamma * h * float(c.H_N @ vk)
-                margin = 0.0
+                margin = ACTIVATION_ROUNDOFF
                 if was_closed[i]:
                     margin = h * h * (abs(c.drift_N) + abs(float(c.H_N @ (minv * f))))
                 if predicted <= margin:
@@ -129,11 +132,13 @@ class MoreauJean:
                     c = kin[i]
                     H[2 * j], H[2 * j + 1] = c.H_N, c.H_T
                     if was_closed[i]:
-                        # A persistent contact keeps its gap, not only its normal velocity, at
-                        # zero: the Jacobian turns with the body within the step, so a purely
-                        # velocity-level law lets the gap creep by O(h) per unit time (then the
-                        # contact drops out and re-impacts). Asking u_N ≥ −g/h removes the creep.
-                        q_step[2 * j] = float(c.H_N @ v_free) + c.gap / h
+                        # A persistent contact may close an open gap, not only keep u_N ≥ 0:
+                        # the Jacobian turns with the body within the step, so a purely
+                        # velocity-level law lets the gap creep open by O(h) per unit time (then
+                        # the contact drops out and re-impacts). Asking u_N ≥ −g/h for g > 0
+                        # removes the creep; a penetration (g < 0) is not pushed out, which
+                        # would inject energy after every impact.
+                        q_step[2 * j] = float(c.H_N @ v_free) + max(c.gap, 0.0) / h
                     else:
                         u_N_k = float(c.H_N @ vk)
                         q_step[2 * j] = float(c.H_N @ v_free) + rest[i] * min(u_N_k, 0.0)

@@ -1,0 +1,95 @@
+"""One-step nonsmooth solvers: one entry point, ``solve(problem, solver=..., **options)``.
+
+    lemke                 Lemke's method on the exact lifted LCP (lemke.lemke_friction)
+    pgs                   nonsmooth Gauss–Seidel with exact 2×2 contact solves
+    enum                  enumeration of all contact-mode combinations (≤ 4 contacts)
+    <backend>             Tresca fixed point of QPs through qpsolvers (e.g. osqp, clarabel)
+    <backend>-relaxed     convex relaxation, one QP (has the sliding-separation artefact)
+
+The QP solvers exist for every backend qpsolvers reports installed; qpsolvers itself is an
+optional extra, imported only when a QP solver is listed or used.
+"""
+from __future__ import annotations
+
+from .problem import (
+    ContactSolution,
+    InfeasibleProblem,
+    NoConvergence,
+    PlanarFrictionProblem,
+    RayTermination,
+    SolverError,
+    complementarity_residual,
+    contact_states,
+    residual_scale,
+)
+
+EXACT_SOLVERS = ("lemke", "pgs", "enum")
+
+
+def _solve_lemke(problem, **options):
+    from .lemke import lemke_friction
+
+    return lemke_friction(problem, **options)
+
+
+def _solve_pgs(problem, **options):
+    from .gauss_seidel import projected_gauss_seidel
+
+    return projected_gauss_seidel(problem, **options)
+
+
+def _solve_enum(problem, **options):
+    from .enumeration import enumerate_modes
+
+    return enumerate_modes(problem, **options)
+
+
+_EXACT = {"lemke": _solve_lemke, "pgs": _solve_pgs, "enum": _solve_enum}
+
+
+def available_solvers() -> list[str]:
+    """Solver names ``solve`` accepts: lemke, pgs, enum, then per installed QP backend its
+    name and name + "-relaxed"."""
+    from .qp import RELAXED_SUFFIX, installed_backends
+
+    names = list(EXACT_SOLVERS)
+    for backend in installed_backends():
+        names += [backend, backend + RELAXED_SUFFIX]
+    return names
+
+
+def solve(problem: PlanarFrictionProblem, solver: str = "lemke", **options) -> ContactSolution:
+    """Solve one step's contact problem with the named solver.
+
+    ``options`` go to the solver (e.g. pgs: tol, max_iter, p0; lemke: formulation,
+    max_pivots; QP: tol, max_iter, check_tol and backend settings). The returned
+    ContactSolution carries iterations, the common residual and info["states"] (per contact
+    "open" | "stick" | "slip+" | "slip-"). Raises SolverError subclasses on failure and
+    ValueError for an unknown solver name.
+    """
+    run = _EXACT.get(solver)
+    if run is not None:
+        return run(problem, **options)
+    from .qp import RELAXED_SUFFIX, installed_backends, relaxed_qp, tresca_fixed_point
+
+    backends = installed_backends()
+    if solver in backends:
+        return tresca_fixed_point(problem, backend=solver, **options)
+    if solver.endswith(RELAXED_SUFFIX) and solver[: -len(RELAXED_SUFFIX)] in backends:
+        return relaxed_qp(problem, backend=solver[: -len(RELAXED_SUFFIX)], **options)
+    raise ValueError(f"unknown solver {solver!r}; choose from: {', '.join(available_solvers())}")
+
+
+__all__ = [
+    "solve",
+    "available_solvers",
+    "ContactSolution",
+    "PlanarFrictionProblem",
+    "SolverError",
+    "RayTermination",
+    "NoConvergence",
+    "InfeasibleProblem",
+    "complementarity_residual",
+    "contact_states",
+    "residual_scale",
+]

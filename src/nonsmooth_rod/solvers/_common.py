@@ -28,8 +28,8 @@ def velocities_and_residual(W, q, lo, hi, p):
 
 
 def max_abs(*vectors) -> float:
-    """Max-norm over several lists of floats (0 for empty)."""
-    return max((abs(x) for v in vectors for x in v), default=0.0)
+    """Max-norm over several float sequences (0 for empty)."""
+    return max((max(map(abs, v), default=0.0) for v in vectors), default=0.0)
 
 
 def relative_floor(*vectors) -> float:
@@ -39,10 +39,14 @@ def relative_floor(*vectors) -> float:
 
 
 def make_solution(
-    problem: PlanarFrictionProblem, p, u, solver: str, iterations: int, residual: float, **info
+    problem: PlanarFrictionProblem, p, u, solver: str, iterations: int, residual: float,
+    state_tol: float = 1e-9, **info
 ) -> ContactSolution:
-    """ContactSolution with the per-contact states every solver reports in ``info["states"]``."""
+    """ContactSolution with the per-contact states every solver reports in ``info["states"]``.
+
+    ``state_tol``: relative tolerance of `contact_states` (looser for the inexact QP solvers).
+    """
+    info["states"] = contact_states(problem, p, u, state_tol)
     p = np.asarray(p, dtype=float)
     u = np.asarray(u, dtype=float)
-    info["states"] = contact_states(problem, p, u)
     return ContactSolution(p=p, u=u, solver=solver, iterations=iterations, residual=residual, info=info)

@@ -22,6 +22,11 @@ Why this is the step law (hi > lo; for hi = lo, β = 0 and p_T = lo·p_N is forc
 σ = 0 and u_T ≥ 0 (slip "+", or rest at the edge). β = (hi − lo)p_N > 0 ⇒ p_T = hi·p_N
 and u_T = −σ ≤ 0 (slip "−"). 0 < β < (hi − lo)p_N ⇒ σ = 0 and u_T = −σ = 0 (stick).
 
+Second formulation ("cone", Anitescu–Potra): z_i = (p_N, b_hi, b_lo, λ) with
+p_T = hi·b_hi + lo·b_lo and w_i = (u_N, λ + hi·u_T, λ + lo·u_T, p_N − b_hi − b_lo). Its matrix
+is copositive (zᵀMz = pᵀWp + Σ λ p_N), the interval one is not (zᵀMz = pᵀWp − Σ lo p_N u_T
++ …); both are used, see ``lemke_friction``.
+
 The pivoting kernels are written once in plain Python (float loops over lists: faster than
 numpy calls for the 3–6 unknowns of a step) and compiled with numba when it is installed;
 ``new_matrix``/``new_vector`` allocate lists in Python and numpy arrays under numba.
@@ -30,8 +35,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import make_solution, relative_floor
-from .problem import NoConvergence, PlanarFrictionProblem, RayTermination
+from .problem import (
+    ContactSolution,
+    NoConvergence,
+    PlanarFrictionProblem,
+    RayTermination,
+    SolverError,
+    classify_contacts,
+)
 
 try:  # numba is an optional accelerator; everything below also runs as plain Python.
     import numba
@@ -52,7 +63,8 @@ INTERVAL, CONE = 0, 1
 FORMULATIONS = {"interval": INTERVAL, "cone": CONE}
 
 # Tolerances of the pivoting, in the units of the normalised data (max |entry| of M and q = 1).
-PIVOT_TOL = 1e-12  # a column entry must exceed this (times the column's max, ≥ 1) to be a pivot
+PIVOT_TOL = 1e-9  # a column entry must exceed this (times the column's max, ≥ 1) to be a pivot
+ZERO_Z0_TOL = 1e-12  # an artificial z0 this small counts as zero (the basis then solves the LCP)
 TIE_TOL = 1e-12  # relative tolerance under which two ratios count as tied
 
 # Accept a friction solution when complementarity_residual ≤ RESIDUAL_TOL · residual_scale.
@@ -102,16 +114,32 @@ def _fill_tableau(T, M, q, n):
         row[2 * n + 1] = q[i]
 
 
-@register_jitable
 def _pivot(T, r, e):
-    """Gauss–Jordan pivot of tableau T on row r, column e."""
-    n_cols = len(T[0])
+    """Gauss–Jordan pivot of tableau T on row r, column e (plain Python: rebuilds list rows,
+    which list comprehensions do fastest; under numba the in-place loop below is used)."""
+    row = T[r]
+    inverse = 1.0 / row[e]
+    row = [x * inverse for x in row]
+    row[e] = 1.0
+    T[r] = row
+    for i, other in enumerate(T):
+        if i != r:
+            factor = other[e]
+            if factor != 0.0:
+                other = [a - factor * b for a, b in zip(other, row)]
+                other[e] = 0.0
+                T[i] = other
+
+
+def _pivot_in_place(T, r, e):
+    """Gauss–Jordan pivot of tableau T on row r, column e, in place (numba version)."""
+    n_cols = T.shape[1]
     row = T[r]
     inverse = 1.0 / row[e]
     for j in range(n_cols):
         row[j] *= inverse
     row[e] = 1.0
-    for i in range(len(T)):
+    for i in range(T.shape[0]):
         if i != r:
             other = T[i]
             factor = other[e]
@@ -119,6 +147,13 @@ def _pivot(T, r, e):
                 for j in range(n_cols):
                     other[j] -= factor * row[j]
                 other[e] = 0.0
+
+
+if HAVE_NUMBA:
+
+    @overload(_pivot)
+    def _pivot_numba(T, r, e):
+        return _pivot_in_place
 
 
 @register_jitable
@@ -190,6 +225,11 @@ def _complementary_pivoting(T, basis, n, max_pivots):
             if T[i][entering] > pivot_tol and (r < 0 or _lex_smaller(T, i, r, entering, n)):
                 r = i
         if r < 0:
+            # A secondary ray — unless z0 already sits at (round-off) zero, in which case the
+            # current complementary basis solves the LCP (singular W makes this happen: z0
+            # reaches 0 on a degenerate pivot without being chosen to leave).
+            if T[z0_row][rhs] <= ZERO_Z0_TOL:
+                return SOLVED, pivots, entering
             return RAY, pivots, entering
         # If z0 ties for leaving, let it leave: that ends the method with a solution.
         a0 = T[z0_row][entering]
@@ -316,23 +356,24 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
 
 @register_jitable
 def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
-    """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots).
+    """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms).
+
+    norms = (‖q‖∞, max|W|, max(‖p‖∞, ‖u‖∞, ‖q‖∞)) for the acceptance test and the contact
+    states (computed here, they cost nothing; in Python after the call, microseconds).
 
     ``formulation``: INTERVAL (3 unknowns per contact) or CONE (4 per contact). The LCP is
     built from W / max|W| and q / max|q| so that the pivoting tolerances act on O(1)
     numbers; p = p̃ · max|q| / max|W| undoes it exactly (u scales with max|q|).
     """
     n_c = len(lo)
-    w_scale = 0.0
-    q_scale = 0.0
+    W_norm = 0.0
+    q_norm = 0.0
     for i in range(2 * n_c):
-        q_scale = max(q_scale, abs(q[i]))
+        q_norm = max(q_norm, abs(q[i]))
         for j in range(2 * n_c):
-            w_scale = max(w_scale, abs(W[i][j]))
-    if w_scale == 0.0:
-        w_scale = 1.0
-    if q_scale == 0.0:
-        q_scale = 1.0
+            W_norm = max(W_norm, abs(W[i][j]))
+    w_scale = W_norm if W_norm > 0.0 else 1.0
+    q_scale = q_norm if q_norm > 0.0 else 1.0
     per_contact = 3 if formulation == INTERVAL else 4
     n = per_contact * n_c
     M = new_matrix(n, n)
@@ -372,7 +413,16 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
             high = hi[i] * p_n_pos
             projected = low if trial < low else (high if trial > high else trial)
             residual = max(residual, r_n, abs(p_t - projected))
-    return p, u, residual, status, pivots
+    norms = (q_norm, W_norm, max(q_norm, _max_abs(p), _max_abs(u)))
+    return p, u, residual, status, pivots, norms
+
+
+@register_jitable
+def _max_abs(values):
+    largest = 0.0
+    for value in values:
+        largest = max(largest, abs(value))
+    return largest
 
 
 if HAVE_NUMBA:
@@ -389,10 +439,10 @@ def _variable_name(index: int, n: int) -> str:
     if index < 0:
         return "none"
     if index < n:
-        return f"w{index}"
+        return f"w[{index}]"
     if index < 2 * n:
-        return f"z{index - n}"
-    return "z0"
+        return f"z[{index - n}]"
+    return "the artificial z0"
 
 
 def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
@@ -450,42 +500,68 @@ def _run_friction_kernel(problem, formulation, max_pivots, jit):
     )
 
 
+def _attempt(problem, formulation, max_pivots, tol, jit):
+    """One Lemke solve of the friction LCP: (p, u, residual, pivots, norms) or the SolverError."""
+    n_c = problem.n_contacts
+    p, u, residual, status, pivots, norms = _run_friction_kernel(problem, formulation, max_pivots, jit)
+    size = (3 if formulation == "interval" else 4) * n_c
+    if status == RAY:
+        return RayTermination(
+            f"lemke: secondary ray after {pivots} pivots on the {formulation} friction LCP of "
+            f"{n_c} contact(s) (size {size}): no solution reached"
+        )
+    if status == PIVOT_LIMIT:
+        return NoConvergence(
+            f"lemke: pivot limit {pivots} reached on the {formulation} friction LCP of {n_c} contact(s)"
+        )
+    scale = norms[2] if norms[2] > 0.0 else 1.0  # = problem.residual_scale(problem, p, u)
+    if not residual <= tol * scale:
+        return NoConvergence(
+            f"lemke: {formulation} LCP solution after {pivots} pivots misses the step law, "
+            f"residual {residual:.3e} > {tol:.0e} × scale {scale:.3e}"
+        )
+    return p, u, residual, pivots, norms
+
+
 def lemke_friction(
     problem: PlanarFrictionProblem,
     *,
     formulation: str = "interval",
+    fallback: bool = True,
     max_pivots: int | None = None,
     tol: float = RESIDUAL_TOL,
     jit: bool | None = None,
 ):
     """Solve the step's friction problem exactly as a lifted LCP (module docstring) by Lemke.
 
-    ``formulation``: "interval" (3 unknowns per contact) or "cone" (4 per contact).
-    Returns a ContactSolution (iterations = pivots). Raises RayTermination / NoConvergence as
-    ``lemke`` does, and NoConvergence if the recovered impulses miss the step law:
-    complementarity_residual > tol · residual_scale (round-off only, normally ~1e-16).
+    ``formulation``: "interval" (3 unknowns per contact, the default) or "cone" (4 per
+    contact). Neither LCP matrix is copositive-plus for a singular W, so neither is
+    guaranteed to be processed by Lemke in floating point; with ``fallback`` a failure of one
+    formulation is retried with the other (their failures are rare and, in random sweeps,
+    never coincide). info["formulation"] says which one produced the solution.
+
+    Returns a ContactSolution (iterations = pivots of the successful formulation). Raises RayTermination /
+    NoConvergence as ``lemke`` does (the first formulation's error, naming the second's), and
+    NoConvergence if the recovered impulses miss the step law: complementarity_residual >
+    tol · residual_scale (round-off only, normally ~1e-15).
     """
     if formulation not in FORMULATIONS:
         raise ValueError(f"lemke: unknown formulation {formulation!r}; choose from {sorted(FORMULATIONS)}")
-    n_c = problem.n_contacts
-    p, u, residual, status, pivots = _run_friction_kernel(problem, formulation, max_pivots, _use_jit(jit))
-    size = (3 if formulation == "interval" else 4) * n_c
-    if status == RAY:
-        raise RayTermination(
-            f"lemke: secondary ray after {pivots} pivots on the {formulation} friction LCP of "
-            f"{n_c} contact(s) (size {size}): no solution reached"
-        )
-    if status == PIVOT_LIMIT:
-        raise NoConvergence(
-            f"lemke: pivot limit {pivots} reached on the {formulation} friction LCP of {n_c} contact(s)"
-        )
-    scale = relative_floor(p, u, problem.q)
-    if not residual <= tol * scale:
-        raise NoConvergence(
-            f"lemke: solution after {pivots} pivots misses the step law, residual {residual:.3e} "
-            f"> {tol:.0e} × scale {scale:.3e}"
-        )
-    return make_solution(problem, p, u, "lemke", pivots, residual, formulation=formulation)
+    jit = _use_jit(jit)
+    result = _attempt(problem, formulation, max_pivots, tol, jit)
+    used = formulation
+    if isinstance(result, SolverError) and fallback:
+        first_error = result
+        used = "cone" if formulation == "interval" else "interval"
+        result = _attempt(problem, used, max_pivots, tol, jit)
+        if isinstance(result, SolverError):
+            raise type(first_error)(f"{first_error.base_message}; fallback: {result.base_message}")
+    if isinstance(result, SolverError):
+        raise result
+    p, u, residual, pivots, (q_norm, W_norm, _) = result
+    p, u = np.asarray(p, dtype=float), np.asarray(u, dtype=float)
+    states = classify_contacts(p.tolist(), u.tolist(), q_norm, W_norm)
+    return ContactSolution(p, u, "lemke", pivots, residual, {"formulation": used, "states": states})
 
 
 __all__ = ["lemke", "lemke_friction", "HAVE_NUMBA"]

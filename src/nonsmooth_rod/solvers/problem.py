@@ -134,10 +134,10 @@ def residual_scale(problem: PlanarFrictionProblem, p: np.ndarray, u: np.ndarray)
     natural scale is the largest of both; a relative tolerance ``tol`` on a solver's result
     means ``complementarity_residual(problem, p) ≤ tol · residual_scale(problem, p, u)``.
     """
-    scale = 0.0
-    for values in (p, u, problem.q):
-        for value in np.asarray(values, dtype=float).tolist():
-            scale = max(scale, abs(value))
+    scale = max(
+        max(map(abs, np.asarray(values, dtype=float).ravel().tolist()), default=0.0)
+        for values in (p, u, problem.q)
+    )
     return scale if scale > 0.0 else 1.0
 
 
@@ -147,24 +147,33 @@ CONTACT_STATES = ("open", "stick", "slip+", "slip-")
 def contact_states(problem: PlanarFrictionProblem, p, u, tol: float = 1e-9) -> list[str]:
     """Per-contact state of a solution: "open" | "stick" | "slip+" | "slip-".
 
-    A contact is open when its normal impulse is negligible (p_N ≤ tol·‖p‖∞); otherwise it
-    slips when |u_T| > tol·max(‖u‖∞, ‖q‖∞) ("slip+" means u_T > 0, so p_T = lo·p_N) and
-    sticks when it does not. Every solver classifies through this one function so that
-    states are comparable between solvers.
+    A contact is open when its normal impulse is negligible, p_N ≤ tol·P with the impulse
+    scale P = max(‖p‖∞, ‖q‖∞ / max|W|) (the second term is the impulse that stops a velocity
+    ‖q‖∞, so a step whose impulses are all round-off is "open" everywhere). Otherwise it slips
+    when |u_T| > tol·V with V = max(‖u‖∞, ‖q‖∞) ("slip+" means u_T > 0, so p_T = lo·p_N) and
+    sticks when it does not. Every solver classifies through this one function so that states
+    are comparable between solvers.
     """
-    p = np.asarray(p, dtype=float).tolist()
-    u = np.asarray(u, dtype=float).tolist()
-    impulse_floor = tol * max((abs(x) for x in p), default=0.0)
-    velocity_floor = tol * max(
-        max((abs(x) for x in u), default=0.0), max((abs(x) for x in problem.q.tolist()), default=0.0)
-    )
+    # plain floats: this runs once per solve, for 1–2 contacts, where numpy calls cost more
+    p = p.tolist() if isinstance(p, np.ndarray) else [float(x) for x in p]
+    u = u.tolist() if isinstance(u, np.ndarray) else [float(x) for x in u]
+    q_norm = max(map(abs, problem.q.tolist()), default=0.0)
+    W_norm = max(map(abs, problem.W.ravel().tolist()), default=0.0)
+    return classify_contacts(p, u, q_norm, W_norm, tol)
+
+
+def classify_contacts(p: list, u: list, q_norm: float, W_norm: float, tol: float = 1e-9) -> list[str]:
+    """`contact_states` on float lists with ‖q‖∞ and max|W| given (solvers that know them
+    already skip recomputing them; the classification is the same)."""
+    impulse_scale = max(max(map(abs, p), default=0.0), q_norm / W_norm if W_norm > 0.0 else 0.0)
+    velocity_scale = max(max(map(abs, u), default=0.0), q_norm)
     states = []
     for i in range(len(p) // 2):
-        if p[2 * i] <= impulse_floor:
+        if p[2 * i] <= tol * impulse_scale:
             states.append("open")
-        elif u[2 * i + 1] > velocity_floor:
+        elif u[2 * i + 1] > tol * velocity_scale:
             states.append("slip+")
-        elif u[2 * i + 1] < -velocity_floor:
+        elif u[2 * i + 1] < -tol * velocity_scale:
             states.append("slip-")
         else:
             states.append("stick")

@@ -1,0 +1,395 @@
+"""The "dynamics package" baseline: smooth (regularised) friction and penalty contact, one ODE.
+
+This is how MSC.ADAMS-style engines in their continuous mode — and the paper's own check — pose
+the problem: no complementarity, no events; every contact force is a smooth function of the state
+and a general-purpose ODE integrator (scipy's RK45, DOP853, Radau, BDF, LSODA) does the rest.
+
+Normal force, per contact, from the penetration δ = −gap and its rate δ̇ = −u_N (clipped ≥ 0):
+
+* ``hunt-crossley`` (default): N = k δⁿ (1 + α δ̇)   (k in N/mⁿ, n = `exponent`, α in s/m);
+* ``spring-damper``:           N = k δ + c δ̇        (k in N/m, c = `damping` in N·s/m).
+
+The defaults are a steel ball of radius 20 mm on a steel plate: Hertz's k = (4/3) E* √R ≈ 2e10
+N/m^1.5 with n = 1.5, and α = 500 s/m, which damps the resting contact's vibration to a damping
+ratio ζ ≈ (α/2) √(N δ / (n m)) ≈ 0.3 for the rod (N ≈ 5 N, δ ≈ 0.4 µm, m ≈ 0.3 kg) and makes a
+closing contact stop without rebound (e ≈ 0, the paper's case).
+
+Friction, T = −μ(u_T) N with u_T the slip velocity and ε the regularisation velocity:
+
+* ``linear`` (paper Fig. 3a): μ(v) = μd · clip(v/ε, −1, 1);
+* ``tanh``:                   μ(v) = μd · tanh(v/ε);
+* ``stribeck`` (paper Fig. 6, MSC.ADAMS's contact friction): μ(v) = sgn(v) μs · step(|v|; 0 → ε)
+  for |v| ≤ ε, then sgn(v) (μs + (μd − μs) step(|v|; ε → ρε)) up to ρε (ρ = `stribeck_ratio`,
+  ADAMS's friction/stiction transition velocity ratio, 10 by default), μd beyond;
+  step(x; a → b) = s² (3 − 2s), s = (x − a)/(b − a) — ADAMS's cubic STEP.
+
+The linear and tanh curves know one coefficient (μd, the sliding one) and cannot hold a contact
+that needs more; only the Stribeck curve has a static peak μs. No curve can stick exactly: a held
+contact creeps at the velocity where μ(v) N equals the force it must hold (≈ ε for a held
+contact).
+
+Contact states for output and phases: "open" while gap > 0, "stick" while |u_T| <
+`stick_velocity` (1e-4 m/s by default), else "slip+"/"slip-"; phases shorter than `min_phase`
+(1 ms by default: the passage of u_T through the stick band at a slip reversal) are merged.
+
+The run stops with a status word instead of hanging: "time-limit" (wall clock), "step-size-collapse"
+(scipy's "required step size is less than spacing between numbers"), "nan", "penetration"
+(beyond `max_penetration`), or "ok".
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
+from scipy.optimize import brentq
+
+from ..model.contacts import DiskOnLine
+from ..model.scene import Scene
+from ..results import Event, Impact, SimulationResult, Trajectory, merge_short_phases, Phase
+from ..validation import InputError, require_nonnegative, require_positive
+
+FRICTION_CURVES = ("stribeck", "tanh", "linear")
+ODE_METHODS = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA, "RK23": RK23}
+EXPLICIT_METHODS = ("RK45", "DOP853", "RK23")
+CONTACT_MODELS = ("hunt-crossley", "spring-damper")
+
+HERTZ_STEEL_STIFFNESS = 2.0e10  # N/m^1.5: (4/3) E* √R, E* = 1.15e11 Pa, R = 20 mm
+DEFAULT_HC_DAMPING = 500.0  # s/m (α of Hunt–Crossley)
+
+
+def _cubic_step(x: float, x0: float, x1: float) -> float:
+    """ADAMS's STEP from 0 at x0 to 1 at x1 (C¹: s² (3 − 2 s))."""
+    if x <= x0:
+        return 0.0
+    if x >= x1:
+        return 1.0
+    s = (x - x0) / (x1 - x0)
+    return s * s * (3.0 - 2.0 * s)
+
+
+def friction_coefficient(curve: str, v: float, eps: float, mu_s: float, mu_d: float,
+                         stribeck_ratio: float = 10.0) -> float:
+    """Signed μ(v) of a regularised friction curve (T = −μ(v) N)."""
+    if curve == "tanh":
+        return mu_d * math.tanh(v / eps)
+    if curve == "linear":
+        return mu_d * max(-1.0, min(1.0, v / eps))
+    if curve == "stribeck":
+        a = abs(v)
+        if a <= eps:
+            m = mu_s * _cubic_step(a, 0.0, eps)
+        else:
+            m = mu_s + (mu_d - mu_s) * _cubic_step(a, eps, stribeck_ratio * eps)
+        return math.copysign(m, v) if a > 0.0 else 0.0
+    raise InputError(f"unknown friction curve '{curve}'; choose from: {', '.join(FRICTION_CURVES)}")
+
+
+@dataclass
+class RegularizedOptions:
+    """Regularised friction, penalty contact, and the ODE integrator that runs them."""
+
+    epsilon: float = 1e-4  # regularisation (stiction transition) velocity, m/s
+    friction_curve: str = "stribeck"
+    stribeck_ratio: float = 10.0  # friction transition velocity / ε (Stribeck curve only)
+    ode_method: str = "RK45"
+    rtol: float = 1e-6
+    atol: float = 1e-9
+    contact_model: str = "hunt-crossley"
+    stiffness: float = HERTZ_STEEL_STIFFNESS
+    exponent: float = 1.5  # Hunt–Crossley only
+    damping: float | None = None  # α [s/m] (Hunt–Crossley) or c [N·s/m] (spring–damper)
+    stick_velocity: float = 1e-4  # |u_T| below this counts as stick in the output, m/s
+    min_phase: float = 1e-3  # s
+    output_dt: float = 1e-3  # spacing of saved samples, s
+    stop_at_impact: str | None = None  # name of a contact whose first touchdown ends the run
+    time_limit: float | None = None  # wall-clock seconds; then status "time-limit"
+    max_penetration: float = 1e-3  # m; deeper: status "penetration"
+    first_step: float | None = None
+    max_step: float = math.inf
+
+    def __post_init__(self):
+        require_positive("epsilon (regularisation velocity)", self.epsilon)
+        require_positive("rtol", self.rtol)
+        require_positive("atol", self.atol)
+        require_positive("stiffness", self.stiffness)
+        require_positive("exponent", self.exponent)
+        require_positive("stick velocity", self.stick_velocity)
+        require_nonnegative("min_phase", self.min_phase)
+        require_positive("output_dt", self.output_dt)
+        require_positive("max_penetration", self.max_penetration)
+        if self.stribeck_ratio <= 1.0:
+            raise InputError(f"stribeck_ratio must exceed 1, got {self.stribeck_ratio!r}")
+        if self.friction_curve not in FRICTION_CURVES:
+            raise InputError(f"unknown friction curve '{self.friction_curve}'; "
+                             f"choose from: {', '.join(FRICTION_CURVES)}")
+        if self.ode_method not in ODE_METHODS:
+            raise InputError(f"unknown ODE method '{self.ode_method}'; choose from: {', '.join(ODE_METHODS)}")
+        if self.contact_model not in CONTACT_MODELS:
+            raise InputError(f"unknown contact model '{self.contact_model}'; "
+                             f"choose from: {', '.join(CONTACT_MODELS)}")
+        if self.damping is None:
+            # Spring–damper: critical-ish damping of a 0.3 kg body on the default spring.
+            self.damping = DEFAULT_HC_DAMPING if self.contact_model == "hunt-crossley" else 2.0 * math.sqrt(
+                self.stiffness * 0.3)
+        require_nonnegative("damping", self.damping)
+        if self.time_limit is not None:
+            require_positive("time_limit", self.time_limit)
+
+
+class _TimeLimit(Exception):
+    pass
+
+
+class _Contact:
+    """Plain-float kinematics of a disk on a line (the RHS runs it millions of times)."""
+
+    def __init__(self, c: DiskOnLine):
+        self.i = 3 * c.body
+        self.ox, self.oy = float(c.offset[0]), float(c.offset[1])
+        self.nx, self.ny = c.line.normal
+        self.tx, self.ty = c.line.tangent
+        self.px, self.py = float(c.line.point[0]), float(c.line.point[1])
+        self.r = float(c.radius)
+        self.belt = float(c.line.velocity)
+
+    def local(self, y, n_dof):
+        """gap, u_N, u_T and the lever arms ρ×n, ρ×t."""
+        i = self.i
+        x, yy, th = y[i], y[i + 1], y[i + 2]
+        vx, vy, om = y[n_dof + i], y[n_dof + i + 1], y[n_dof + i + 2]
+        c, s = math.cos(th), math.sin(th)
+        dx, dy = c * self.ox - s * self.oy, s * self.ox + c * self.oy
+        nx, ny, tx, ty = self.nx, self.ny, self.tx, self.ty
+        gap = nx * (x + dx - self.px) + ny * (yy + dy - self.py) - self.r
+        rx, ry = dx - self.r * nx, dy - self.r * ny
+        arm_n = rx * ny - ry * nx
+        arm_t = rx * ty - ry * tx
+        u_N = nx * vx + ny * vy + arm_n * om
+        u_T = tx * vx + ty * vy + arm_t * om - self.belt
+        return gap, u_N, u_T, arm_n, arm_t
+
+
+class Regularized:
+    """Regularised friction + penalty contact, integrated by a scipy ODE solver step by step."""
+
+    name = "regularized"
+
+    def __init__(self, options: RegularizedOptions | None = None):
+        self.options = options or RegularizedOptions()
+
+    # ------------------------------------------------------------------ forces
+    def _normal(self, delta: float, delta_dot: float) -> float:
+        o = self.options
+        if delta <= 0.0:
+            return 0.0
+        if o.contact_model == "hunt-crossley":
+            n = o.stiffness * delta**o.exponent * (1.0 + o.damping * delta_dot)
+        else:
+            n = o.stiffness * delta + o.damping * delta_dot
+        return n if n > 0.0 else 0.0
+
+    def _forces(self, y):
+        """Per contact: (N, T, gap, u_T, arm_n, arm_t)."""
+        o = self.options
+        out = []
+        for c, law in zip(self._contacts, self._laws):
+            gap, u_N, u_T, arm_n, arm_t = c.local(y, self._n_dof)
+            N = self._normal(-gap, -u_N)
+            T = 0.0
+            if N > 0.0 and law.mu_s > 0.0:
+                T = -friction_coefficient(o.friction_curve, u_T, o.epsilon, law.mu_s, law.mu_d,
+                                          o.stribeck_ratio) * N
+            out.append((N, T, gap, u_T, arm_n, arm_t))
+        return out
+
+    def _rhs(self, t, y):
+        self._nfev += 1
+        if self._nfev % 64 == 0 and self._deadline is not None and time.perf_counter() > self._deadline:
+            raise _TimeLimit
+        n = self._n_dof
+        gen = np.array(self._scene.force(t, y[:n], y[n:]), dtype=float)
+        for c, (N, T, _, _, arm_n, arm_t) in zip(self._contacts, self._forces(y)):
+            if N == 0.0:
+                continue
+            i = c.i
+            gen[i] += N * c.nx + T * c.tx
+            gen[i + 1] += N * c.ny + T * c.ty
+            gen[i + 2] += N * arm_n + T * arm_t
+        out = np.empty(2 * n)
+        out[:n] = y[n:]
+        out[n:] = gen * self._minv
+        return out
+
+    def _state_of(self, gap, u_T):
+        if gap > 0.0:
+            return "open"
+        if abs(u_T) < self.options.stick_velocity:
+            return "stick"
+        return "slip+" if u_T > 0 else "slip-"
+
+    # ------------------------------------------------------------------ main loop
+    def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
+        require_positive("t_end", t_end)
+        o = self.options
+        for c in scene.contacts:
+            if not isinstance(c, DiskOnLine):
+                raise InputError("the regularised integrator handles disk/point-on-line contacts only")
+        self._scene = scene
+        self._n_dof = n = scene.n_dof
+        self._minv = scene.inverse_mass_diagonal
+        self._contacts = [_Contact(c) for c in scene.contacts]
+        self._laws = [c.law.friction for c in scene.contacts]
+        self._nfev = 0
+        names = [c.name for c in scene.contacts]
+        stop_index = names.index(o.stop_at_impact) if o.stop_at_impact in names else None
+        wall0 = time.perf_counter()
+        cpu0 = time.process_time()
+        self._deadline = None if o.time_limit is None else wall0 + o.time_limit
+
+        y = np.concatenate([np.asarray(q0, float), np.asarray(v0, float)])
+        kwargs = dict(rtol=o.rtol, atol=o.atol, max_step=o.max_step)
+        if o.first_step is not None:
+            kwargs["first_step"] = o.first_step
+        solver = ODE_METHODS[o.ode_method](self._rhs, 0.0, y, t_end, **kwargs)
+
+        grid = np.arange(0.0, t_end + 0.5 * o.output_dt, o.output_dt)
+        grid = grid[grid <= t_end]
+        samples_t, samples_y = [0.0], [y.copy()]
+        g_next = 1
+        events: list[Event] = []
+        impacts: list[Impact] = []
+        status, message = "ok", f"reached t_end = {t_end:g} s"
+        steps = 0
+        min_h, max_pen = math.inf, 0.0
+        step_sizes = []
+        # Per contact: state now, and the state changes (time, new state).
+        local = [c.local(y, n) for c in self._contacts]
+        states = [self._state_of(g, u) for g, _, u, _, _ in local]
+        # A contact starting exactly at gap 0 with no approach velocity is resting, not open.
+        states = [("stick" if s == "open" and abs(loc[0]) < 1e-12 else s) for s, loc in zip(states, local)]
+        changes = [[(0.0, s)] for s in states]
+        t_stop = None
+        try:
+            while solver.status == "running":
+                t_old, y_old = solver.t, solver.y.copy()
+                msg = solver.step()
+                if solver.status == "failed":
+                    status = "step-size-collapse"
+                    message = f"{o.ode_method} failed at t = {solver.t:.9g} s: {msg}"
+                    break
+                steps += 1
+                h = solver.t - t_old
+                step_sizes.append(h)
+                min_h = min(min_h, h)
+                y_new = solver.y
+                if not np.all(np.isfinite(y_new)):
+                    status, message = "nan", f"non-finite state at t = {solver.t:.9g} s"
+                    break
+                dense = None
+                new_local = [c.local(y_new, n) for c in self._contacts]
+                # Touchdown of the stop contact: the root of its gap within the step.
+                if stop_index is not None and local[stop_index][0] > 0.0 >= new_local[stop_index][0]:
+                    dense = solver.dense_output()
+                    c = self._contacts[stop_index]
+                    t_hit = brentq(lambda tt: c.local(dense(tt), n)[0], t_old, solver.t, xtol=1e-14, rtol=1e-15)
+                    y_hit = dense(t_hit)
+                    impacts.append(Impact(t_hit, names[stop_index], y_hit[:n].copy(), y_hit[n:].copy(),
+                                          y_hit[n:].copy(), np.zeros(len(names)), np.zeros(len(names))))
+                    events.append(Event(t_hit, "impact", names[stop_index], {"model": "penalty"}))
+                    t_stop = t_hit
+                # Contact-state changes within the step, located on the dense output.
+                t_limit = t_stop if t_stop is not None else solver.t
+                for ci, c in enumerate(self._contacts):
+                    new_state = self._state_of(new_local[ci][0], new_local[ci][2])
+                    if new_state != states[ci]:
+                        dense = dense or solver.dense_output()
+                        t_change = self._locate(c, dense, t_old, t_limit, states[ci], new_state)
+                        changes[ci].append((t_change, new_state))
+                        states[ci] = new_state
+                    max_pen = max(max_pen, -new_local[ci][0])
+                # Output samples inside the step.
+                while g_next < grid.size and grid[g_next] <= t_limit:
+                    dense = dense or solver.dense_output()
+                    samples_t.append(float(grid[g_next]))
+                    samples_y.append(dense(grid[g_next]))
+                    g_next += 1
+                local = new_local
+                if t_stop is not None:
+                    samples_t.append(t_stop)
+                    samples_y.append(dense(t_stop))
+                    status, message = "ok", f"stopped at the touchdown of {o.stop_at_impact}"
+                    break
+                if max_pen > o.max_penetration:
+                    status = "penetration"
+                    message = (f"penetration {max_pen:.3g} m exceeds {o.max_penetration:g} m at "
+                               f"t = {solver.t:.9g} s")
+                    break
+        except _TimeLimit:
+            status = "time-limit"
+            message = f"wall-clock limit of {o.time_limit:g} s reached at t = {solver.t:.9g} s"
+        t_final = t_stop if t_stop is not None else float(solver.t)
+        if samples_t[-1] < t_final and status != "ok":
+            samples_t.append(float(solver.t))
+            samples_y.append(solver.y.copy())
+        elif status == "ok" and t_stop is None and samples_t[-1] < t_final:
+            samples_t.append(t_final)
+            samples_y.append(solver.y.copy())
+        nfev = self._nfev
+        traj = self._trajectory(samples_t, samples_y)
+        phases = {}
+        for ci, name in enumerate(names):
+            ph = []
+            for j, (ts, st) in enumerate(changes[ci]):
+                te = changes[ci][j + 1][0] if j + 1 < len(changes[ci]) else t_final
+                if te > ts or not ph:
+                    ph.append(Phase(st, ts, max(te, ts)))
+            phases[name] = merge_short_phases(ph, o.min_phase)
+        cpu = time.process_time() - cpu0
+        if status != "ok":
+            events.append(Event(t_final, status, "", {"message": message}))
+        h_arr = np.array(step_sizes) if step_sizes else np.array([np.nan])
+        stats = {"nfev": nfev, "njev": int(getattr(solver, "njev", 0)), "nlu": int(getattr(solver, "nlu", 0)),
+                 "steps": steps, "min_step": float(np.min(h_arr)), "median_step": float(np.median(h_arr)),
+                 "max_penetration": max_pen, "t_final": t_final, "wall_time_s": time.perf_counter() - wall0,
+                 "epsilon": o.epsilon, "friction_curve": o.friction_curve, "ode_method": o.ode_method,
+                 "rtol": o.rtol, "atol": o.atol}
+        self.step_sizes = np.array(step_sizes)  # kept for step-size histories
+        return SimulationResult(self.name, status, message, traj, names, events, impacts, phases,
+                                steps=steps, cpu_time_s=cpu, stats=stats)
+
+    def _locate(self, c: _Contact, dense, t0, t1, old, new) -> float:
+        """Time within [t0, t1] at which the contact left state `old` (root of the boundary)."""
+        n, thr = self._n_dof, self.options.stick_velocity
+        if old == "open" or new == "open":
+            f = lambda tt: c.local(dense(tt), n)[0]  # noqa: E731
+        elif old == "stick" or new == "stick":
+            side = new if new != "stick" else old
+            sgn = 1.0 if side == "slip+" else -1.0
+            f = lambda tt: sgn * c.local(dense(tt), n)[2] - thr  # noqa: E731
+        else:  # slip+ ↔ slip- within one step: the zero of u_T
+            f = lambda tt: c.local(dense(tt), n)[2]  # noqa: E731
+        try:
+            if f(t0) * f(t1) < 0.0:
+                return float(brentq(f, t0, t1, xtol=1e-13))
+        except ValueError:
+            pass
+        return float(t1)
+
+    def _trajectory(self, ts, ys) -> Trajectory:
+        n, nc = self._n_dof, len(self._contacts)
+        ys = np.array(ys).reshape(len(ts), 2 * n)
+        a = np.empty((len(ts), n))
+        N = np.zeros((len(ts), nc))
+        T = np.zeros((len(ts), nc))
+        modes = np.empty((len(ts), nc), dtype=object)
+        deadline, self._deadline = self._deadline, None
+        for k, y in enumerate(ys):
+            a[k] = self._rhs(ts[k], y)[n:] if np.all(np.isfinite(y)) else np.nan
+            for ci, (Nk, Tk, gap, u_T, _, _) in enumerate(self._forces(y)):
+                N[k, ci], T[k, ci] = Nk, Tk
+                modes[k, ci] = self._state_of(gap, u_T)
+        self._deadline = deadline
+        return Trajectory(np.array(ts, dtype=float), ys[:, :n].copy(), ys[:, n:].copy(), a, N, T, modes)
