@@ -165,7 +165,7 @@ def cmd_simulate(args) -> int:
     if args.json:
         sys.stdout.write(dumps_json(summary))
     elif not args.quiet:
-        _print_report(run, out_dir, Console())
+        _print_report(run, out_dir, Console(soft_wrap=True))
     if run.status != "ok":
         print(f"nonsmooth-rod: run ended with status '{run.status}': {run.result.message}", file=sys.stderr)
         return EXIT_RUN_FAILED

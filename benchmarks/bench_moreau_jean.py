@@ -1,0 +1,75 @@
+"""Microseconds per Moreau–Jean step on the paper's rod, per one-step solver.
+
+    python benchmarks/bench_moreau_jean.py [--repeats 7] [--quick]
+
+Whole runs (release → ball B's impact, case 2, h = 1e-4, ~3750 steps) are timed, the CPU time
+divided by the steps; the median of the repeats is reported. In the same run, the yardstick:
+one 3×3 numpy.linalg.solve in a plain Python loop. This machine is noisy: read the ratios.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+
+from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.solvers import available_solvers
+
+
+def yardstick_us(n: int = 20000, repeats: int = 7) -> float:
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((3, 3)) + 3 * np.eye(3)
+    b = rng.standard_normal(3)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            np.linalg.solve(A, b)
+        times.append((time.perf_counter() - t0) / n * 1e6)
+    return statistics.median(times)
+
+
+def step_us(solver: str, h: float = 1e-4, repeats: int = 7, fast: bool = True) -> tuple[float, int, str]:
+    problem = RodProblem.paper(2)
+    scene = problem.scene()
+    q0, v0 = problem.initial_state()
+    options = MoreauJeanOptions(h=h, solver=solver, stop_at_impact="B", fast=fast)
+    warm = MoreauJean(options).run(scene, q0, v0, 10.0)  # warm-up (and JIT compilation)
+    if warm.status != "ok":
+        return float("nan"), warm.steps, warm.message
+    times, steps = [], 0
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        res = MoreauJean(options).run(scene, q0, v0, 10.0)
+        elapsed = time.perf_counter() - t0
+        steps = res.steps
+        times.append(elapsed / steps * 1e6)
+    return statistics.median(times), steps, "ok"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--quick", action="store_true", help="3 repeats, h = 1e-3, exact solvers only")
+    args = parser.parse_args(argv)
+    repeats = 3 if args.quick else args.repeats
+    h = 1e-3 if args.quick else 1e-4
+    ys = yardstick_us(repeats=repeats)
+    print(f"yardstick: 3x3 numpy.linalg.solve in a Python loop: {ys:.2f} us")
+    print(f"Moreau-Jean on the rod (case 2, h = {h:g}, whole run to ball B's impact), median of {repeats}:")
+    print(f"{'solver':<22}{'us/step':>10}{'x yardstick':>13}{'steps':>8}")
+    rows = [("lemke (compiled run)", "lemke", True)]
+    rows += [(name, name, False) for name in available_solvers()
+             if not (args.quick and (name.endswith("-relaxed") or name not in ("lemke", "pgs", "enum")))]
+    for label, solver, fast in rows:
+        us, steps, status = step_us(solver, h=h, repeats=repeats, fast=fast)
+        note = "" if status == "ok" else f"  FAILED: {status}"
+        print(f"{label:<22}{us:>10.2f}{us / ys:>13.2f}{steps:>8d}{note}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
