@@ -154,8 +154,11 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
     pN = np.zeros((n_steps, nc))
     pT = np.zeros((n_steps, nc))
     states = np.zeros((n_steps, nc), dtype=np.int8)
-    impact_t = np.full(nc, np.nan)  # first closing impact of each contact
-    impact_step = np.full(nc, -1)
+    # Every closing impact: time, step and contact, in order.
+    impact_t = np.empty(n_steps)
+    impact_step = np.empty(n_steps, dtype=np.int64)
+    impact_contact = np.empty(n_steps, dtype=np.int64)
+    n_impacts = 0
     q[0] = q0
     v[0] = v0
     slip_sign = np.zeros(nc)
@@ -277,13 +280,16 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             v[k + 1, d] = v_next[d]
             q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         for i in range(nc):
-            if closed_now[i] and not was_closed[i] and impact_step[i] < 0:
+            if closed_now[i] and not was_closed[i]:
                 u_before = _dot(H_N[i], vk)
                 if u_before < -1e-9:
-                    impact_step[i] = k
-                    impact_t[i] = t + _crossing_offset(gaps[i], u_before, _dot(H_N[i], a_free) + drifts[i], h)
-                    if i == stop_index:
-                        t_stop = impact_t[i]
+                    t_hit = t + _crossing_offset(gaps[i], u_before, _dot(H_N[i], a_free) + drifts[i], h)
+                    impact_t[n_impacts] = t_hit
+                    impact_step[n_impacts] = k
+                    impact_contact[n_impacts] = i
+                    n_impacts += 1
+                    if i == stop_index and math.isnan(t_stop):
+                        t_stop = t_hit
         for i in range(nc):
             was_closed[i] = closed_now[i]
         finite = True
@@ -297,8 +303,8 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
         done = k + 1
         if not math.isnan(t_stop):
             break
-    return (q, v, pN, pT, states, done, status, fail_step, impact_t, impact_step, t_stop,
-            solves_total, inconsistent_total)
+    return (q, v, pN, pT, states, done, status, fail_step, impact_t[:n_impacts], impact_step[:n_impacts],
+            impact_contact[:n_impacts], t_stop, solves_total, inconsistent_total)
 
 
 def _crossing_offset(g, u, a, h):

@@ -227,19 +227,18 @@ class MoreauJean:
     def _run_compiled(self, scene, q0, v0, n_steps, stop_index, names, t_end) -> SimulationResult:
         opts = self.options
         wall = time.process_time()
-        (q, v, pN, pT, states, n_done, code, fail_step, impact_t, impact_step, t_stop, solves,
-         inconsistent) = fast_moreau_jean.run_compiled(scene, q0, v0, opts.h, opts.theta, opts.activation_gamma,
+        (q, v, pN, pT, states, n_done, code, fail_step, impact_t, impact_step, impact_contact, t_stop,
+         solves, inconsistent) = fast_moreau_jean.run_compiled(scene, q0, v0, opts.h, opts.theta, opts.activation_gamma,
                                                        n_steps, -1 if stop_index is None else stop_index)
         cpu = time.process_time() - wall
         h = opts.h
         events, impacts = [], []
         minv = scene.inverse_mass_diagonal
         f = scene.force(0.0, q[0], v[0])
-        for i in np.argsort(impact_t):
-            k = int(impact_step[i])
-            if k < 0 or k >= n_done:
+        for t_hit, k, i in zip(impact_t, impact_step, impact_contact):
+            k, i, t_hit = int(k), int(i), float(t_hit)
+            if k >= n_done:
                 continue
-            t_hit = float(impact_t[i])
             v_hit = v[k] + (t_hit - k * h) * minv * f
             q_hit = q[k] + (t_hit - k * h) * v[k]
             impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v[k + 1].copy(), pN[k].copy(), pT[k].copy()))
