@@ -80,6 +80,7 @@ def test_panel_colours_rolling_blue_and_sliding_red(case2):
     # stick, slip−, slip+: three pieces, blue then red, switching at the phase boundaries.
     assert [to_rgba(ln.get_color()) for ln in pieces] == [BLUE, RED, RED]
     assert pieces[0].get_xdata()[-1] == pytest.approx(case2.phases[0].t_end, abs=1e-12)
+    assert pieces[1].get_xdata()[0] == pytest.approx(case2.phases[0].t_end, abs=1e-12)
     assert case2.phases[0].t_end == pytest.approx(case2.rolling.t_r1, abs=1e-6)
     # The actual T/N equals T/N(0) = 0.2628 while rolling and −μd·sgn(v_C) = ±0.2 while sliding.
     t, ratio = drawn_series(axis(fig, "T_over_N"))
@@ -89,16 +90,16 @@ def test_panel_colours_rolling_blue_and_sliding_red(case2):
 
 
 def test_panel_png_and_svg_files(case2, tmp_path):
-    written = plot_run(case2, tmp_path / "panel.png", formats=("png", "svg"), dpi=50)
+    written = plot_run(case2, tmp_path / "panel.png", formats=("png", "svg"), dpi=60)
     assert [p.name for p in written] == ["panel.png", "panel.svg"]
     with Image.open(tmp_path / "panel.png") as im:
         assert im.format == "PNG"
-        assert im.size == (1000, 380)  # 20 × 7.6 in at 50 dpi
+        assert im.size == (1200, 456)  # 20 × 7.6 in at 60 dpi
         pixels = np.asarray(im.convert("RGB"), dtype=int)
     # Both regime colours really are on the image (not a blank canvas).
     for colour in (BLUE, RED):
         rgb = np.array([round(255 * c) for c in colour[:3]])
-        assert np.sum(np.all(np.abs(pixels - rgb) < 8, axis=-1)) > 200
+        assert np.sum(np.all(np.abs(pixels - rgb) < 40, axis=-1)) > 200
     assert (tmp_path / "panel.png").stat().st_size > 20_000
     root = ET.parse(tmp_path / "panel.svg").getroot()
     assert root.tag.endswith("svg")

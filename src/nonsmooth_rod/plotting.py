@@ -10,6 +10,7 @@ regime-coloured pieces into the plotted arrays, so tests can compare them with t
 """
 from __future__ import annotations
 
+import io
 import json
 import math
 from dataclasses import dataclass
@@ -28,7 +29,7 @@ from .validation import InputError
 REGIME_COLOURS = {"stick": "tab:blue", "slip+": "tab:red", "slip-": "tab:red", "flight": "tab:gray"}
 REGIME_WORDS = {"stick": "rolling", "slip+": "sliding (v_C > 0)", "slip-": "sliding (v_C < 0)",
                 "flight": "flight"}
-DATA_GID = "data"        # a run drawn as regime-coloured line pieces sharing their end points
+DATA_GID = "data"        # a run drawn as regime-coloured line pieces sharing the switch samples
 MARKER_GID = "markers"   # a compared run drawn as regime-coloured markers, pieces not overlapping
 ROLLING_GID = "rolling"  # T/N under the pure-rolling hypothesis
 FORMATS = ("png", "svg")
@@ -123,7 +124,10 @@ def load_run_dir(folder, *, rolling: bool = True) -> RunData:
         raise InputError(f"{traj_path} holds fewer than two samples: nothing to plot")
     for c in needed[:-1]:
         if table[c].dtype == object:  # a numeric column that did not parse: blank or text cells
-            table[c] = np.array([float(x) if x not in ("", "nan") else np.nan for x in table[c]])
+            try:
+                table[c] = np.array([float(x) if x != "" else np.nan for x in table[c]])
+            except ValueError:
+                raise InputError(f"{traj_path}: column {c} holds text where numbers belong") from None
     table["mode"] = np.asarray(table["mode"], dtype=object)
     bad = sorted(set(table["mode"]) - set(REGIME_COLOURS))
     if bad:
@@ -148,21 +152,22 @@ def regime_pieces(modes) -> list[tuple[int, int, str]]:
 
 def plot_by_regime(ax, t, y, modes, *, markers: bool = False, gid: str | None = None,
                    n_markers: int = 45, **kw) -> None:
-    """y(t) coloured by regime. Lines: each piece also takes the next piece's first sample so the
-    curve stays connected. Markers: pieces do not overlap; every sample is drawn once (in the
+    """y(t) coloured by regime. Lines: each piece after the first also starts from the previous
+    piece's last sample (the switch instant), so the curve stays connected and changes colour
+    exactly at the switch. Markers: pieces do not overlap; every sample is drawn once (in the
     data; about `n_markers` are shown, so the lines beneath stay visible)."""
     t, y = np.asarray(t, float), np.asarray(y, float)
     gid = gid or (MARKER_GID if markers else DATA_GID)
     stride = max(1, len(t) // n_markers)
     for start, stop, mode in regime_pieces(modes):
-        end = stop if markers else min(stop + 1, len(t))
+        begin = start if markers else max(start - 1, 0)
         style = dict(color=REGIME_COLOURS.get(mode, "k"))
         if markers:
             style.update(ls="none", marker="o", ms=3.5, mfc="none", mew=0.8, markevery=stride)
         else:
             style.update(lw=1.4)
         style.update(kw)
-        ax.plot(t[start:end], y[start:end], gid=gid, **style)
+        ax.plot(t[begin:stop], y[begin:stop], gid=gid, **style)
 
 
 def drawn_series(ax, gid: str = DATA_GID) -> tuple[np.ndarray, np.ndarray]:
@@ -174,8 +179,8 @@ def drawn_series(ax, gid: str = DATA_GID) -> tuple[np.ndarray, np.ndarray]:
     xs, ys = [], []
     for k, ln in enumerate(lines):
         x, y = (np.asarray(a, float) for a in ln.get_data())
-        if k < len(lines) - 1 and overlap:
-            x, y = x[:-overlap], y[:-overlap]
+        if k > 0 and overlap:
+            x, y = x[overlap:], y[overlap:]
         xs.append(x)
         ys.append(y)
     return np.concatenate(xs), np.concatenate(ys)
@@ -198,9 +203,24 @@ def save_figure(fig: Figure, path, formats=("png",), dpi: int = 110) -> list[Pat
     for fmt in formats:
         target = path.with_name(f"{stem}.{fmt}")
         with atomic_path(target) as tmp:
-            fig.savefig(tmp, dpi=dpi, format=fmt)
+            if fmt == "png":
+                _save_png(fig, tmp, dpi)
+            else:
+                fig.savefig(tmp, dpi=dpi, format=fmt)
         written.append(target)
     return written
+
+
+def _save_png(fig: Figure, path, dpi: int) -> None:
+    """PNG with a 256-colour palette: line plots hold few colours, so nothing visible changes
+    and the file is about a third of the size (figures are meant to be committed)."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format="png")
+    buf.seek(0)
+    with Image.open(buf) as im:
+        im.convert("RGB").quantize(colors=256).save(path, format="PNG", optimize=True)
 
 
 def _fmt_time(t) -> str:
@@ -269,7 +289,7 @@ def panel_figure(data: RunData, compare: RunData | None = None) -> Figure:
         tv = getattr(rh, name)
         if tv is not None:
             ax.axvline(tv, color="tab:green", lw=0.9)
-            ax.annotate(name, (tv, 0.92), xycoords=("data", "axes fraction"), xytext=(3, 0),
+            ax.annotate(name, (tv, 0.04), xycoords=("data", "axes fraction"), xytext=(3, 0),
                         textcoords="offset points", color="tab:green")
     ax.set(title="(a) T/N under pure rolling", xlabel="t [s]")
     info = axes[0, 1]
@@ -304,6 +324,17 @@ def panel_figure(data: RunData, compare: RunData | None = None) -> Figure:
     return fig
 
 
+def lines_and_markers(first: RunData, second: RunData) -> tuple[RunData, RunData]:
+    """Which of two runs of one problem to draw as lines and which as markers: a time-stepping
+    (Moreau–Jean) run is the markers whatever the order it was given in; otherwise the first
+    is the lines. The lines' run keeps the rolling hypothesis for panel (a)."""
+    if first.method == "moreau-jean" and second.method != "moreau-jean":
+        if second.rolling is None:
+            second.rolling = first.rolling
+        return second, first
+    return first, second
+
+
 def plot_run(run, path, *, formats=("png",), dpi: int = 110, compare=None) -> list[Path]:
     """The Fig. 14-style panel of a RodRun (or RunData) written atomically to `path`
     (suffix replaced per format). Kept as `simulate`'s entry point for figure.png."""
@@ -326,7 +357,9 @@ def frame_indices(t, n_frames: int) -> np.ndarray:
     """Samples nearest to n_frames evenly spaced times from the first to the last sample."""
     t = np.asarray(t, float)
     targets = np.linspace(t[0], t[-1], n_frames)
-    return np.array([int(np.argmin(np.abs(t - tt))) for tt in targets])
+    idx = np.array([int(np.argmin(np.abs(t - tt))) for tt in targets])
+    idx[-1] = len(t) - 1  # the very last state (after an impact, events repeat the time)
+    return idx
 
 
 def _draw_pose(ax, problem: RodProblem, x_O, theta, mode, *, trail=None, rod_gid="rod") -> None:
@@ -387,7 +420,7 @@ def frames_figure(data: RunData, n_frames: int = 8, columns: int = 4) -> Figure:
     return fig
 
 
-def write_gif(data: RunData, path, n_frames: int = 40, frame_ms: int = 80, dpi: int = 70) -> Path:
+def write_gif(data: RunData, path, n_frames: int = 40, frame_ms: int = 80, dpi: int = 60) -> Path:
     """An animation of the motion as a GIF (Pillow, through matplotlib's Agg canvas)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from PIL import Image

@@ -20,6 +20,7 @@ made with; a sweep with other settings refuses to mix its rows into the same fol
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -41,6 +42,7 @@ SCENARIOS = ("slide-at-start", "roll-until-r1", "roll-until-r2", "roll-to-impact
 CSV_COLUMNS = ("mu_s", "mu_d", "theta0_deg", "scenario", "t_transition", "t_impact", "phases")
 CSV_NAME, SETTINGS_NAME, THRESHOLDS_NAME, MAP_NAME = ("regime_map.csv", "sweep.json", "thresholds.csv",
                                                       "regime_map")
+LOCK_NAME = ".sweep.lock"
 SWEEP_SCHEMA = "nonsmooth-rod/sweep/1"
 SCENARIO_COLOURS = {"slide-at-start": "#d62728", "roll-until-r1": "#ff9f4a", "roll-until-r2": "#8fbbe0",
                     "roll-to-impact": "#1f5fa8"}
@@ -56,7 +58,7 @@ class SweepSettings:
     method: str = "event-driven"
     h: float = 1e-4
     solver: str = "lemke"
-    rtol: float = 1e-12
+    rtol: float | None = None  # None: the method's own default (event-driven 1e-12)
 
     def simulate_kwargs(self) -> dict:
         # The event-driven samples only feed the phases here; a coarse output grid saves time
@@ -260,8 +262,12 @@ def _parse_row(fields: list[str]) -> dict | None:
 def read_rows(path) -> tuple[list[dict], int]:
     """Rows of a regime_map.csv and the number of unreadable lines (an interrupted write)."""
     path = Path(path)
-    with open(path, newline="", encoding="utf-8") as fh:
-        lines = list(csv.reader(fh))
+    text = path.read_text(encoding="utf-8")
+    if text and not text.endswith("\n"):
+        # Every row is written with its newline: a last line without one was cut mid-write,
+        # even if its cells happen to parse (a truncated phases text would).
+        text = text[: text.rfind("\n") + 1]
+    lines = list(csv.reader(io.StringIO(text, newline="")))
     if not lines:
         return [], 0
     if tuple(lines[0]) != CSV_COLUMNS:
@@ -310,8 +316,6 @@ def _settings_record(base: RodProblem, settings: SweepSettings) -> dict:
 def _prepare_folder(out_dir: Path, record: dict) -> list[dict]:
     """Check a folder's earlier sweep is compatible; return its readable rows."""
     csv_path, settings_path = out_dir / CSV_NAME, out_dir / SETTINGS_NAME
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"--out '{out_dir}' exists and is not a folder")
     if settings_path.exists():
         try:
             old = json.loads(settings_path.read_text(encoding="utf-8"))
@@ -332,6 +336,31 @@ def _prepare_folder(out_dir: Path, record: dict) -> list[dict]:
     return rows
 
 
+@contextlib.contextmanager
+def folder_lock(out_dir: Path):
+    """Refuse a second sweep writing into the same folder at the same time (their appends
+    would interleave). An advisory lock, released by the system if the process dies."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock
+        yield
+        return
+    path = out_dir / LOCK_NAME
+    fh = open(path, "w")
+    try:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        fh.close()
+        raise InputError(f"another sweep is writing to {out_dir} (it holds {path}): wait for it or use "
+                         "another --out") from None
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            path.unlink()
+        fh.close()
+
+
 def _chunks(points, size):
     return [points[i:i + size] for i in range(0, len(points), size)]
 
@@ -343,7 +372,14 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
     if jobs < 1:
         raise InputError(f"jobs must be at least 1, got {jobs}")
     out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"--out '{out_dir}' exists and is not a folder")
     out_dir.mkdir(parents=True, exist_ok=True)
+    with folder_lock(out_dir):
+        return _sweep(base, grid, out_dir, settings, jobs, progress, plot, formats, dpi)
+
+
+def _sweep(base, grid, out_dir, settings, jobs, progress, plot, formats, dpi) -> SweepResult:
     record = _settings_record(base, settings)
     earlier = _prepare_folder(out_dir, record)
     done = {point_key(r["mu_s"], r["mu_d"], r["theta0_deg"]) for r in earlier}
@@ -462,8 +498,7 @@ def regime_map_figure(rows, grid: Grid, base: RodProblem, ths: list[Thresholds],
 
     names, code = _scenario_codes(rows)
     colours = [SCENARIO_COLOURS.get(n, OTHER_COLOUR) for n in names]
-    cmap = ListedColormap(colours)
-    cmap.set_bad("white")
+    cmap = ListedColormap(colours).with_extremes(bad="white")
     norm = BoundaryNorm(np.arange(len(names) + 1) - 0.5, len(names))
     mu_s_edges = _edges(grid.mu_s)
     mu_s_vals = np.asarray(sorted(set(np.round(grid.mu_s, KEY_DIGITS))), float)
@@ -533,7 +568,7 @@ def regime_map_figure(rows, grid: Grid, base: RodProblem, ths: list[Thresholds],
         ax_t.plot([], [], "k--", lw=1.0, label="rolling hypothesis: |T/N| reaches μs")
         ax_t.set(xlabel="μs", ylabel="t [s]", title="end of rolling and impact time", xlim=(x_lo, x_hi))
         ax_t.grid(alpha=0.3)
-        ax_t.legend(fontsize=7)
+        ax_t.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, -0.13), ncol=2)
     else:
         n = len(grid.theta0_deg)
         cols = min(n, 3)

@@ -61,7 +61,7 @@ def _same_problem(a, b) -> list[str]:
 
 
 def cmd_plot(args) -> int:
-    from ..plotting import load_run_dir, panel_figure, save_figure, frames_figure, write_gif
+    from ..plotting import frames_figure, lines_and_markers, load_run_dir, panel_figure, save_figure, write_gif
 
     if args.folder is None and not args.paper_figures:
         raise InputError("give a results folder (from `nonsmooth-rod simulate --out DIR`) or --paper-figures")
@@ -84,10 +84,7 @@ def cmd_plot(args) -> int:
             if differ:
                 raise InputError(f"--compare folder '{args.compare}' is a run of another problem "
                                  f"(differs in {', '.join(differ)})")
-            # Event-driven as lines, Moreau-Jean as markers, whichever folder came first.
-            if data.method == "moreau-jean" and compare.method != "moreau-jean":
-                compare.rolling = data.rolling
-                data, compare = compare, data
+            data, compare = lines_and_markers(data, compare)
         written += save_figure(panel_figure(data, compare), out_dir / "panel", args.format, args.dpi)
     if data is not None and args.frames:
         written += save_figure(frames_figure(data, args.frames), out_dir / "frames", args.format, args.dpi)

@@ -47,6 +47,7 @@ def register(subparsers) -> None:
     num.add_argument("--out", default="sweep", help="output folder (default ./sweep); an existing sweep there is resumed")
     num.add_argument("--no-plot", action="store_true", help="do not draw regime_map.png")
     num.add_argument("--format", default="png", help="comma-separated image formats: png, svg (default png)")
+    num.add_argument("--dpi", type=_int, default=110, help="resolution of regime_map.png (default 110)")
     num.add_argument("--quiet", action="store_true", help="no progress bar and no summary")
     p.set_defaults(handler=cmd_sweep)
 
@@ -80,13 +81,15 @@ def cmd_sweep(args) -> int:
     formats = tuple(dict.fromkeys(f.strip().lower() for f in args.format.split(",") if f.strip()))
     if not formats or any(f not in FORMATS for f in formats):
         raise InputError(f"--format must be among {', '.join(FORMATS)}, got {args.format!r}")
+    if not 30 <= args.dpi <= 600:
+        raise InputError(f"--dpi must lie in [30, 600], got {args.dpi}")
     # The body (and e, g) from the shared options; friction and tilt are set per grid point.
     body_args = copy.copy(args)
     body_args.mu_s, body_args.mu_d, body_args.theta0_deg = 0.28, 0.20, float(grid.theta0_deg[0])
     base = build_problem(body_args)
     settings = SweepSettings(method=args.method, h=args.h, solver=args.solver)
     result = sweep(base, grid, args.out, settings, jobs=jobs, plot=not args.no_plot, formats=formats,
-                   progress=not args.quiet and sys.stderr.isatty())
+                   dpi=args.dpi, progress=not args.quiet and sys.stderr.isatty())
     if not args.quiet:
         _report(result)
     failed = [r for r in result.grid_rows if r["scenario"] in ("failed",)]
@@ -101,13 +104,13 @@ def _report(result) -> None:
 
     console = Console()
     counts = Counter(r["scenario"] for r in result.grid_rows)
-    table = Table(title=f"regime map, {len(result.grid_rows)} points",
-                  caption=f"{result.computed} computed, {result.reused} from an earlier run")
+    table = Table(title=f"regime map, {len(result.grid_rows)} points")
     table.add_column("scenario")
     table.add_column("points", justify="right")
     for name, n in sorted(counts.items()):
         table.add_row(name, str(n))
     console.print(table)
+    console.print(f"{result.computed} computed, {result.reused} from an earlier run")
     for th in result.thresholds:
         console.print(f"θ0 = {th.theta0_deg:g}°: T/N(0) = {th.T_over_N_initial:.4f}, "
                       f"max T/N = {th.T_over_N_max:.4f} (t = {th.t_max:.4f} s), min T/N = {th.T_over_N_min:.4f}")

@@ -1,0 +1,197 @@
+"""Regime map: simulated scenarios against the rolling hypothesis' thresholds; resuming."""
+from __future__ import annotations
+
+import math
+import shutil
+
+import numpy as np
+import pytest
+
+from nonsmooth_rod import regime
+from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.plotting import axis
+from nonsmooth_rod.regime import (
+    CSV_COLUMNS,
+    Grid,
+    SweepSettings,
+    parse_range,
+    predicted_scenario,
+    read_rows,
+    scenario_of,
+    sweep,
+    thresholds,
+)
+from nonsmooth_rod.results import Phase
+from nonsmooth_rod.validation import InputError
+
+BASE = RodProblem.paper()
+MU_S = np.linspace(0.20, 0.42, 12)  # step 0.02: spans T/N(0) ≈ 0.263 and max T/N ≈ 0.290
+
+
+@pytest.fixture(scope="module")
+def small_sweep(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep")
+    return sweep(BASE, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), out, jobs=2, plot=True)
+
+
+def test_thresholds_at_60_degrees():
+    th = thresholds(BASE, 60.0)
+    assert th.T_over_N_initial == pytest.approx(0.2628, abs=1e-4)
+    assert th.T_over_N_max == pytest.approx(0.2900, abs=1e-4)   # the paper's "≈ 0.29"
+    assert th.t_max == pytest.approx(0.1584, abs=1e-3)
+    # Rolling to the impact needs μs ≥ |T/N| at the horizontal: ≈ 1.97, far beyond steel on steel.
+    assert th.T_over_N_min == pytest.approx(-1.968, abs=1e-3)
+    assert th.rolling.T_over_N[-1] == pytest.approx(th.T_over_N_min, abs=1e-9)
+
+
+def test_scenarios_agree_with_the_analytic_thresholds(small_sweep):
+    rows = small_sweep.grid_rows
+    assert [r["mu_s"] for r in rows] == pytest.approx(MU_S)
+    th = small_sweep.thresholds[0]
+    bounds = (th.T_over_N_initial, th.T_over_N_max, -th.T_over_N_min)
+    step = MU_S[1] - MU_S[0]
+    checked = 0
+    for r in rows:
+        expected, t_expected = predicted_scenario(th.rolling, r["mu_s"])
+        if min(abs(r["mu_s"] - b) for b in bounds) < step:
+            continue  # within one grid step of a boundary: either side is acceptable
+        checked += 1
+        assert r["scenario"] == expected, r
+        if expected == "slide-at-start":
+            assert r["t_transition"] == 0.0
+        else:  # the rolling phase is exact in both: transition times agree to the event tolerance
+            assert r["t_transition"] == pytest.approx(t_expected, abs=1e-6)
+        assert 0.34 < r["t_impact"] < 0.39
+    assert checked >= 9
+    # Each boundary lies between the two grid points where the simulated scenario changes.
+    scen = [r["scenario"] for r in rows]
+    changes = [(MU_S[k], MU_S[k + 1], scen[k], scen[k + 1]) for k in range(len(rows) - 1) if scen[k] != scen[k + 1]]
+    assert [(a, b) for _, _, a, b in changes] == [("slide-at-start", "roll-until-r1"),
+                                                 ("roll-until-r1", "roll-until-r2")]
+    for (lo, hi, _, _), bound in zip(changes, bounds[:2]):
+        assert lo < bound <= hi
+
+
+def test_roll_to_impact_needs_mu_s_beyond_the_horizontal_ratio(tmp_path):
+    res = sweep(BASE, Grid(np.array([1.90, 2.05]), np.array([60.0]), mu_d_ratio=0.75), tmp_path,
+                jobs=1, plot=False)
+    assert [r["scenario"] for r in res.grid_rows] == ["roll-until-r2", "roll-to-impact"]
+    rolled = res.grid_rows[1]
+    assert math.isnan(rolled["t_transition"])
+    assert rolled["phases"].startswith("stick 0.000000..") and ";" not in rolled["phases"]
+    # Rolling to the horizontal takes the rolling hypothesis' t_h = 0.38082 s.
+    assert rolled["t_impact"] == pytest.approx(res.thresholds[0].rolling.t_horizontal, abs=1e-6)
+
+
+def test_at_30_degrees_the_start_is_the_maximum_so_no_r1_region(tmp_path):
+    th = thresholds(BASE, 30.0)
+    assert th.T_over_N_max == pytest.approx(th.T_over_N_initial, abs=1e-6)  # ≈ 0.410
+    res = sweep(BASE, Grid(np.array([0.39, 0.43]), np.array([30.0]), mu_d_ratio=0.75), tmp_path,
+                jobs=1, plot=False)
+    assert [r["scenario"] for r in res.grid_rows] == ["slide-at-start", "roll-until-r2"]
+
+
+def test_map_cells_and_boundaries(small_sweep):
+    from nonsmooth_rod.regime import regime_map_figure
+
+    fig = regime_map_figure(small_sweep.grid_rows, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), BASE,
+                            small_sweep.thresholds)
+    ax = axis(fig, "map")
+    mesh = ax.collections[0]
+    names, code = regime._scenario_codes(small_sweep.grid_rows)
+    cells = np.asarray(mesh.get_array()).ravel()
+    assert [names[int(c)] for c in cells] == [r["scenario"] for r in small_sweep.grid_rows]
+    for gid, value in (("T_over_N_initial", 0.26278), ("T_over_N_max", 0.29003)):
+        (line,) = [ln for ln in ax.get_lines() if ln.get_gid() == gid]
+        assert line.get_xdata()[0] == pytest.approx(value, abs=1e-5)
+    times = axis(fig, "times")
+    (tr,) = [ln for ln in times.get_lines() if ln.get_gid() == "t_transition:60"]
+    np.testing.assert_array_equal(tr.get_ydata(), [r["t_transition"] for r in small_sweep.grid_rows])
+    assert (small_sweep.out_dir / "regime_map.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("cut", [15, -5])  # inside the numbers; inside the phases text
+def test_resume_after_truncation_gives_the_same_csv(small_sweep, tmp_path, cut):
+    src = small_sweep.out_dir
+    full = (src / "regime_map.csv").read_text()
+    work = tmp_path / "resume"
+    shutil.copytree(src, work)
+    lines = full.splitlines(keepends=True)
+    # Header, three rows and part of a fourth: what an interrupted append leaves behind.
+    (work / "regime_map.csv").write_text("".join(lines[:4]) + lines[4][:cut])
+    res = sweep(BASE, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), work, jobs=2, plot=False)
+    assert (res.reused, res.computed) == (3, 9)
+    assert (work / "regime_map.csv").read_text() == full
+
+
+def test_interrupted_sweep_keeps_its_rows_and_resumes(tmp_path, monkeypatch):
+    grid = Grid(np.array([0.22, 0.28, 0.34, 0.40]), np.array([60.0]), mu_d_ratio=0.75)
+    real = regime.classify_point
+    calls = []
+
+    def interrupting(*args, **kwargs):
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        calls.append(args)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(regime, "classify_point", interrupting)
+    with pytest.raises(KeyboardInterrupt):
+        sweep(BASE, grid, tmp_path, jobs=1, plot=False)
+    rows, bad = read_rows(tmp_path / "regime_map.csv")
+    assert len(rows) == 2 and bad == 0
+    monkeypatch.setattr(regime, "classify_point", real)
+    res = sweep(BASE, grid, tmp_path, jobs=1, plot=False)
+    assert (res.reused, res.computed) == (2, 2)
+    assert [r["scenario"] for r in res.grid_rows] == ["slide-at-start", "roll-until-r1", "roll-until-r2",
+                                                      "roll-until-r2"]
+
+
+def test_other_settings_refuse_the_folder(small_sweep, tmp_path):
+    work = tmp_path / "other"
+    shutil.copytree(small_sweep.out_dir, work)
+    with pytest.raises(InputError, match="other settings"):
+        sweep(BASE, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), work,
+              SweepSettings(method="moreau-jean", h=1e-3), jobs=1, plot=False)
+    (work / "sweep.json").unlink()
+    with pytest.raises(InputError, match="without sweep.json"):
+        sweep(BASE, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), work, jobs=1, plot=False)
+
+
+def test_csv_columns(small_sweep):
+    header = (small_sweep.out_dir / "regime_map.csv").read_text().splitlines()[0]
+    assert tuple(header.split(",")) == CSV_COLUMNS
+
+
+def test_grid_points_and_ranges():
+    assert parse_range("0.1:0.3:3", "x") == pytest.approx([0.1, 0.2, 0.3])
+    assert parse_range("0.5", "x") == pytest.approx([0.5])
+    assert parse_range("0.1,0.4", "x") == pytest.approx([0.1, 0.4])
+    for bad in ("0.1:0.3", "0.1:0.3:0", "0.1:0.3:2.5", "a:b:3", "nan", "0.1:0.2:1"):
+        with pytest.raises(InputError):
+            parse_range(bad, "x")
+    # A μd grid keeps only μd ≤ μs.
+    pts = Grid(np.array([0.1, 0.3]), np.array([60.0]), mu_d=np.array([0.05, 0.2])).points()
+    assert pts == [(0.1, 0.05, 60.0), (0.3, 0.05, 60.0), (0.3, 0.2, 60.0)]
+    with pytest.raises(InputError):
+        Grid(np.array([0.1]), np.array([95.0]), mu_d_ratio=0.5)
+    with pytest.raises(InputError):
+        Grid(np.array([0.1]), np.array([60.0]), mu_d_ratio=1.2)
+
+
+def test_scenario_of_phase_sequences():
+    ph = lambda *modes: [Phase(m, k, k + 1) for k, m in enumerate(modes)]  # noqa: E731
+    assert scenario_of(ph("slip-", "slip+")) == "slide-at-start"
+    assert scenario_of(ph("stick", "slip-", "slip+")) == "roll-until-r1"
+    assert scenario_of(ph("stick", "slip+")) == "roll-until-r2"
+    assert scenario_of(ph("stick")) == "roll-to-impact"
+    assert scenario_of(ph("stick"), "painleve") == "painleve"
+
+
+def test_a_second_sweep_into_a_busy_folder_is_refused(tmp_path):
+    grid = Grid(np.array([0.3]), np.array([60.0]), mu_d_ratio=0.75)
+    with regime.folder_lock(tmp_path):
+        with pytest.raises(InputError, match="another sweep is writing"):
+            sweep(BASE, grid, tmp_path, jobs=1, plot=False)
+    res = sweep(BASE, grid, tmp_path, jobs=1, plot=False)  # free again once the first is done
+    assert res.computed == 1 and not (tmp_path / regime.LOCK_NAME).exists()
