@@ -7,8 +7,9 @@ radians) with
 * ``initial_state()``  — (q0, v0), centre-of-mass coordinates (x, y, θ) of every body,
 * closed-form answers  — methods named after what they return (``impact_times``,
   ``slope_acceleration``, ``stick_time`` ...),
-* ``measure_*``        — functions that read the same quantities off a `SimulationResult`,
-  so that tests and examples compare like with like.
+* measurement helpers — `ball_height`, `rest_time`, `slope_motion`, `first_slip_time`,
+  `stick_slip_phases`, `impact_rate_pairs`, `ball_velocities` read the same quantities off a
+  `SimulationResult`, so that tests and examples compare like with like.
 
 `run(toy, method, t_end, ...)` runs any toy with Moreau–Jean or the event-driven reference.
 The closed forms are those of shared/design/nonsmooth-notes.md ("Closed forms for tests");
@@ -22,17 +23,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from .integrators.event_driven import EventDriven, EventDrivenOptions
 from .integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+from .io import atomic_path
 from .model.body import RigidBody, cross2, rotate
 from .model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLine
 from .model.laws import ContactLaw
 from .model.scene import Scene
 from .results import SimulationResult
-from .validation import InputError, require_friction_pair, require_in_range, require_positive
+from .validation import (
+    InputError,
+    require_friction_pair,
+    require_in_range,
+    require_nonnegative,
+    require_positive,
+)
 
 G = 9.81
 
@@ -40,19 +49,13 @@ G = 9.81
 # ------------------------------------------------------------------------------------ running
 def run(toy, method: str = "moreau-jean", t_end: float = 1.0, *, h: float = 1e-3, theta: float = 0.5,
         solver: str = "lemke", rtol: float = 1e-12, output_dt: float = 1e-3,
-        zeno_interval: float = 1e-9, fast: bool | None = None) -> SimulationResult:
-    """Run a toy from its initial state with Moreau–Jean ("moreau-jean") or the event-driven
-    reference ("event-driven").
-
-    `fast` picks Moreau–Jean's compiled loop where the scene allows it; by default it is used
-    unless the toy needs every impact recorded (the compiled loop records only the first impact
-    of each contact).
-    """
+        zeno_interval: float = 1e-9, fast: bool = True) -> SimulationResult:
+    """Run a toy from its initial state with Moreau–Jean ("moreau-jean", step h, θ, one-step
+    solver; `fast` allows its compiled loop where the scene permits) or the event-driven
+    reference ("event-driven", tolerance rtol, samples every output_dt)."""
     scene = toy.scene()
     q0, v0 = toy.initial_state()
     if method == "moreau-jean":
-        if fast is None:
-            fast = not getattr(toy, "records_every_impact", False)
         integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, fast=fast))
     elif method == "event-driven":
         integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, output_dt=output_dt,
@@ -164,12 +167,12 @@ def rest_time(result: SimulationResult, toy: BouncingBall, speed_tol: float | No
 # ---------------------------------------------------------------------------- block on incline
 @dataclass(frozen=True)
 class BlockOnIncline:
-    """A flat rectangular block on an incline of angle α, launched along it with `v0`
-    (positive = up the slope), two-coefficient friction μs ≥ μd on both corners.
+    """A flat rectangular block on an incline of angle α, at rest or launched up the slope
+    at `v0` ≥ 0, two-coefficient friction μs ≥ μd on both bottom corners.
 
     Sticks iff tan α ≤ μs (from rest); slides down with g (sin α − μd cos α) otherwise.
     Launched up, it decelerates at g (sin α + μd cos α), stops, and stays iff tan α ≤ μs.
-    The block is wide and low (width ≫ height μ) so that it slides without tipping.
+    The block is wide and low (width ≫ μ × height) so that it slides without tipping.
     """
 
     angle: float = math.radians(20.0)
@@ -184,6 +187,7 @@ class BlockOnIncline:
     def __post_init__(self):
         require_in_range("incline angle", self.angle, 0.0, math.pi / 2, open_hi=True)
         require_friction_pair(self.mu_s, self.mu_d)
+        require_nonnegative("v0 (launch speed up the slope)", self.v0)
         for name in ("width", "height", "mass", "g"):
             require_positive(name, getattr(self, name))
 
@@ -220,36 +224,25 @@ class BlockOnIncline:
 
     @property
     def stop_time(self) -> float:
-        """When a block launched up the slope comes to rest (0 if not launched up)."""
-        return max(self.v0, 0.0) / -self.sliding_up_acceleration
+        """When a block launched up the slope comes to rest (0 if not launched)."""
+        return self.v0 / -self.sliding_up_acceleration
 
     def slope_velocity(self, t) -> np.ndarray:
+        """Closed-form velocity along the slope: up at v0, stopping, then held or sliding back."""
         t = np.asarray(t, dtype=float)
         ts = self.stop_time
-        up = self.v0 + self.sliding_up_acceleration * t
         after = np.zeros_like(t) if self.holds else self.sliding_down_acceleration * (t - ts)
-        if self.v0 < 0:  # launched down: slides down (μd) throughout if it cannot hold, else
-            # decelerates at g (μd cos α − sin α) to rest
-            a = self.sliding_down_acceleration
-            vel = self.v0 + a * t
-            return np.minimum(vel, 0.0) if a > 0 else vel
-        return np.where(t < ts, up, after)
+        return np.where(t < ts, self.v0 + self.sliding_up_acceleration * t, after)
 
     def slope_position(self, t) -> np.ndarray:
+        """Closed-form displacement along the slope from the start."""
         t = np.asarray(t, dtype=float)
         ts = self.stop_time
-        if self.v0 < 0:
-            a = self.sliding_down_acceleration
-            if a > 0:
-                t_rest = -self.v0 / a
-                tc = np.minimum(t, t_rest)
-                return self.v0 * tc + 0.5 * a * tc**2
-            return self.v0 * t + 0.5 * a * t**2
-        up = self.v0 * np.minimum(t, ts) + 0.5 * self.sliding_up_acceleration * np.minimum(t, ts) ** 2
+        tc = np.minimum(t, ts)
+        up = self.v0 * tc + 0.5 * self.sliding_up_acceleration * tc**2
         if self.holds:
             return up
-        dt = np.maximum(t - ts, 0.0)
-        return up + 0.5 * self.sliding_down_acceleration * dt**2
+        return up + 0.5 * self.sliding_down_acceleration * np.maximum(t - ts, 0.0) ** 2
 
 
 def slope_motion(result: SimulationResult, toy) -> tuple[np.ndarray, np.ndarray]:
@@ -558,27 +551,25 @@ class RockingBlock:
         return np.array([cx, cy, self.tilt]), np.zeros(3)
 
 
-def impact_rate_pairs(result: SimulationResult, *, extrapolate: bool = True) -> list[tuple[float, float, float]]:
-    """(t, θ̇ before, θ̇ after) for each impact of a run.
+def impact_rate_pairs(result: SimulationResult, *, extrapolate: bool = False) -> list[tuple[float, float, float]]:
+    """(t, θ̇ before, θ̇ after) of body 0 at each impact of a run.
 
     Moreau–Jean's post-impact velocity is the end-of-step velocity, one step of gravity after
-    the impact; with `extrapolate`, the following step's velocity change (pure rocking by then)
-    is used to carry θ̇ back to the impact time, which removes that O(h) bias.
+    the impact. With `extrapolate`, the next step's change of θ̇ (pure rocking by then) carries
+    it back to the impact time, which removes that O(h) part of the error (the Jacobians are
+    still taken at the step's start, |θ̇| h away from the impact configuration).
     """
     out = []
     tr = result.trajectory
     for imp in result.impacts:
-        before, after = imp.v_before[2], imp.v_after[2]
+        before, after = float(imp.v_before[2]), float(imp.v_after[2])
         if extrapolate and result.method == "moreau-jean":
-            h = result.stats["h"]
-            k = int(round(imp.t / h + 0.5))  # index of the first sample after the impact
-            k = max(1, min(k, len(tr.t) - 2))
-            # the impact step ends at t[k] with v_after; slope of the next step
-            k = int(np.argmin(np.abs(tr.v[:, 2] - after)))
-            if k + 1 < len(tr.t):
-                slope = (tr.v[k + 1, 2] - tr.v[k, 2]) / h
-                after = after - slope * (tr.t[k] - imp.t)
-        out.append((imp.t, before, after))
+            k = np.flatnonzero(np.all(tr.v == imp.v_after, axis=1))
+            if k.size and k[0] + 1 < len(tr.t):
+                k = int(k[0])
+                rate = (tr.v[k + 1, 2] - tr.v[k, 2]) / (tr.t[k + 1] - tr.t[k])
+                after -= rate * (tr.t[k] - imp.t)
+        out.append((float(imp.t), before, after))
     return out
 
 
@@ -591,12 +582,14 @@ class PainleveRod:
     The sliding equations for the end moving away from the centre of mass (slip velocity < 0)
     lose consistency where J/m + a² cos²θ < μd a² cos θ sin θ: Painlevé's paradox, possible
     only for μd > 4/3 (thin uniform rod, J = m a²/3). The toy launches the end sliding at
-    `slip_speed` (< 0) at angle `theta0`, outside that band, with the rod falling into it.
+    `slip_speed` (< 0) at angle `theta0`, below that band: friction lifts the rod into it
+    while the end still slides. (Only the lower end is a contact: keep runs short of the rod
+    turning through the floor.)
     """
 
     half_length: float = 0.5
-    theta0: float = math.radians(60.0)
-    slip_speed: float = -4.0
+    theta0: float = math.radians(30.0)
+    slip_speed: float = -10.0
     theta_rate: float = 0.0
     mu_s: float = 2.0
     mu_d: float = 2.0
@@ -733,27 +726,45 @@ class BallRow:
         return ((p - m2 * e * (v1 - v2)) / (m1 + m2), (p + m1 * e * (v1 - v2)) / (m1 + m2))
 
     def simultaneous_outcome(self) -> np.ndarray:
-        """Velocities after one simultaneous Moreau impact of all pairs in contact (every pair
-        closed at once: ball 0 arriving, the others touching): the LCP of the chain, solved."""
-        from .onestep import solve_two_coefficient
+        """Three equal balls, ball 0 arriving at v on two touching balls at rest, all three
+        taking part in one Moreau impact (both pairs in the step's problem at once):
+        u⁺ + e u⁻ ≥ 0 ⊥ p ≥ 0 on both pairs gives p₁ = 2 p₂ = 2 (1 + e) m v / 3, so
+        v' = ((1 − 2e)/3, (1 + e)/3, (1 + e)/3) v; for e = 1, (−1/3, 2/3, 2/3) v, energy kept."""
+        self._require_equal_trio()
+        v, e = self.velocities[0], self.restitution
+        return np.array([(1 - 2 * e) / 3, (1 + e) / 3, (1 + e) / 3]) * v
 
-        n = len(self.masses)
-        minv = 1.0 / np.array(self.masses)
-        v = np.array(self.velocities, dtype=float)
-        # relative normal velocity of pair i: v[i+1] − v[i]; impulse p_i pushes i+1 forward
-        H = np.zeros((n - 1, n))
-        for i in range(n - 1):
-            H[i, i], H[i, i + 1] = -1.0, 1.0
-        # embed as planar contacts with a zero tangential row (frictionless)
-        Hfull = np.zeros((2 * (n - 1), n))
-        Hfull[0::2] = H
-        W = Hfull @ (minv[:, None] * Hfull.T)
-        W[1::2, 1::2] += np.eye(n - 1)  # decoupled tangential rows (no tangential motion)
-        u = H @ v
-        qv = np.zeros(2 * (n - 1))
-        qv[0::2] = u + self.restitution * np.minimum(u, 0.0)
-        res = solve_two_coefficient(W, qv, np.zeros(n - 1), np.zeros(n - 1), np.zeros(n - 1), solver="lemke")
-        return v + minv * (H.T @ res.p[0::2])
+    def sequential_outcome(self) -> np.ndarray:
+        """The same balls with gaps between them, e = 1: a chain of two-ball collisions, each
+        swapping the velocities of equal masses, leaves (0, 0, v) — what a real cradle shows."""
+        self._require_equal_trio()
+        if self.restitution != 1.0:
+            raise InputError("the sequential outcome (0, 0, v) holds for e = 1")
+        return np.array([0.0, 0.0, self.velocities[0]])
+
+    def _require_equal_trio(self):
+        if len(self.masses) != 3 or len(set(self.masses)) != 1 or any(self.velocities[1:]):
+            raise InputError("the cradle outcomes are for three equal balls, the last two at rest")
+
+
+def save_figure(fig, out_dir, name: str) -> "Path":
+    """Write a matplotlib figure to out_dir/name.png atomically and close it; returns the path."""
+    import matplotlib.pyplot as plt
+
+    path = Path(out_dir) / f"{name}.png"
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+    return path
+
+
+def example_parser(description: str):
+    """The command line every toy example shares: `--out DIR` for its figure."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--out", default=".", help="folder for the figure (default: current folder)")
+    return parser
 
 
 def ball_velocities(result: SimulationResult) -> np.ndarray:
@@ -764,5 +775,6 @@ def ball_velocities(result: SimulationResult) -> np.ndarray:
 __all__ = [
     "run", "BouncingBall", "BlockOnIncline", "PushedBlock", "DiskOnIncline", "BeltOscillator",
     "RockingBlock", "PainleveRod", "BallRow", "ball_height", "rest_time", "slope_motion",
-    "first_slip_time", "stick_slip_phases", "impact_rate_pairs", "ball_velocities",
+    "first_slip_time", "stick_slip_phases", "impact_rate_pairs", "ball_velocities", "save_figure",
+    "example_parser",
 ]

@@ -255,6 +255,19 @@ class EventDriven:
             pN[i], pT[i] = res.p[2 * j], res.p[2 * j + 1]
         return v_after, pN, pT
 
+    @staticmethod
+    def _sliding_singular(scene, t, y, modes, t0, y0) -> bool:
+        """Has the constrained system of a mode with sliding contacts become (nearly) singular
+        since the segment started: |det A| fallen by three orders of magnitude?"""
+        if not any(m in SLIP_SIGN for m in modes):
+            return False
+        n = scene.n_dof
+        A0 = mode_dynamics(scene, t0, y0[:n], y0[n:], modes).matrix
+        A1 = mode_dynamics(scene, t, y[:n], y[n:], modes).matrix
+        if not A0.size:
+            return False
+        return abs(np.linalg.det(A1)) <= 1e-3 * abs(np.linalg.det(A0))
+
     def _check_accumulation(self, scene, t, q, v, i):
         """Stop with "zeno" when a rebound cannot leave the contact tolerance band: the next
         impacts would follow within it, ever closer (an accumulation point). The accumulation
@@ -317,8 +330,14 @@ class EventDriven:
                                 events=funcs or None, dense_output=True)
                 steps += int(sol.t.size - 1)
                 nfev += int(sol.nfev)
+                singular_stop = False
                 if sol.status == -1:
-                    raise _Stop("failed", f"integration failed at t = {sol.t[-1]:.6g} s: {sol.message}")
+                    if not self._sliding_singular(scene, sol.t[-1], sol.y[:, -1], modes, t, y0):
+                        raise _Stop("failed", f"integration failed at t = {sol.t[-1]:.6g} s: {sol.message}")
+                    # The integrator stalled as A → 0 with the normal force unbounded, before the
+                    # painleve event (det A = 0) could be bracketed: the same stop, reached from
+                    # inside the consistent region. Keep the samples up to there.
+                    singular_stop = True
                 # Which event ended the segment (earliest; ties resolved by order)?
                 t_stop, which = sol.t[-1], None
                 if sol.status == 1:
@@ -340,6 +359,11 @@ class EventDriven:
                 interval_modes.append(list(modes))
                 t = t_stop
                 q, v = y_stop[:n_dof].copy(), y_stop[n_dof:].copy()
+                if singular_stop:
+                    raise _Stop("painleve",
+                                f"Painlevé configuration at t = {t:.12g} s: the sliding problem loses "
+                                "consistency (A → 0) with the normal force growing without bound; the run "
+                                "stops here")
                 if which is None:
                     break
                 kind, i = meanings[which]

@@ -122,6 +122,14 @@ class DiskOnDisk:
     law: ContactLaw = field(default_factory=ContactLaw)
     name: str = "disk-disk"
 
+    def __post_init__(self):
+        require_nonnegative(f"{self.name} radius_a", self.radius_a)
+        require_nonnegative(f"{self.name} radius_b", self.radius_b)
+        if self.body_a < 0 or self.body_b < 0:
+            raise InputError(f"{self.name}: body indices must be non-negative")
+        if self.body_a == self.body_b:
+            raise InputError(f"{self.name}: a disk–disk contact joins two different bodies")
+
     def kinematics(self, q: np.ndarray, v: np.ndarray, n_dof: int) -> ContactKinematics:
         ia, ib = 3 * self.body_a, 3 * self.body_b
         da = rotate(q[ia + 2], self.offset_a)
@@ -143,6 +151,13 @@ class DiskOnDisk:
         H_N[ib : ib + 3] -= (n[0], n[1], cross2(rho_b, n))
         H_T[ia : ia + 3] += (t[0], t[1], cross2(rho_a, t))
         H_T[ib : ib + 3] -= (t[0], t[1], cross2(rho_b, t))
-        # Velocity-product terms are only used by the event-driven integrator, which treats
-        # disk–disk contacts at impulse level only (impacts); persistent contact is not needed.
-        return ContactKinematics(gap, H_N, H_T, 0.0, 0.0, 0.0)
+        # g̈ = H_N a + Ḣ_N v: the centres' centripetal accelerations along n, plus the turn of
+        # n itself, ṅ·w = |w_⊥|²/dist for the relative velocity w of the centres. (Moreau–Jean
+        # uses it for its activation margin and impact-time root; the event-driven integrator
+        # takes no disk–disk contacts, so the tangential term is left at zero.)
+        om_a, om_b = v[ia + 2], v[ib + 2]
+        w = (v[ia] - om_a * da[1] - v[ib] + om_b * db[1], v[ia + 1] + om_a * da[0] - v[ib + 1] - om_b * db[0])
+        w_n = w[0] * n[0] + w[1] * n[1]
+        drift_N = (-om_a * om_a * (da[0] * n[0] + da[1] * n[1]) + om_b * om_b * (db[0] * n[0] + db[1] * n[1])
+                   + (w[0] * w[0] + w[1] * w[1] - w_n * w_n) / dist)
+        return ContactKinematics(gap, H_N, H_T, drift_N, 0.0, 0.0)
