@@ -70,9 +70,12 @@ def mode_dynamics(scene: Scene, t: float, q: np.ndarray, v: np.ndarray,
         lam = np.linalg.solve(A, b)
     except np.linalg.LinAlgError:
         # Redundant constraints (e.g. two sticking contacts of one body at rest): forces are
-        # statically indeterminate; the least-norm forces still give the unique motion.
+        # statically indeterminate and any split gives the same (unique) motion. The
+        # least-norm split can put one contact outside its friction cone although another
+        # split holds; we take the split deepest inside all cones (_most_admissible_split).
         singular = True
         lam = np.linalg.lstsq(A, b, rcond=None)[0]
+        lam = _most_admissible_split(A, lam, owners, modes, scene)
     for (i, role), value in zip(owners, lam):
         if role == "N":
             normal[i] = value
@@ -83,3 +86,47 @@ def mode_dynamics(scene: Scene, t: float, q: np.ndarray, v: np.ndarray,
             tangential[i] = -SLIP_SIGN[modes[i]] * scene.contacts[i].law.friction.mu_d * value
     a = free_acc + minv * (G @ lam)
     return ModeDynamics(a, normal, tangential, A, singular)
+
+
+def _most_admissible_split(A, lam0, owners, modes, scene):
+    """Among the statically indeterminate forces λ0 + Z z (Z = null space of A), the split that
+    maximises the smallest margin min(N_i, μs N_i − |T_i|) over the closed contacts.
+
+    This is the question the event-driven stick test asks ("can μs hold it?"): it answers yes
+    exactly when some split lies inside every cone, whatever the least-norm split says.
+    """
+    from scipy.linalg import null_space
+    from scipy.optimize import linprog
+
+    Z = null_space(A)
+    if Z.shape[1] == 0:
+        return lam0
+    k = Z.shape[1]
+    index = {}
+    for j, (i, role) in enumerate(owners):
+        index.setdefault(i, {})[role] = j
+    rows, rhs = [], []
+
+    def add(coef_lam, const=0.0):
+        # margin = coef·λ + const ≥ t  ⇔  −coef·Z z + t ≤ coef·λ0 + const
+        rows.append(np.r_[-(coef_lam @ Z), 1.0])
+        rhs.append(float(coef_lam @ lam0) + const)
+
+    n = len(lam0)
+    for i, roles in index.items():
+        e_n = np.zeros(n)
+        j_n = roles.get("N", roles.get("N+slip"))
+        e_n[j_n] = 1.0
+        add(e_n)
+        if "T" in roles:
+            mu = scene.contacts[i].law.friction.mu_s
+            e_t = np.zeros(n)
+            e_t[roles["T"]] = 1.0
+            add(mu * e_n - e_t)
+            add(mu * e_n + e_t)
+    scale = max(1.0, float(np.max(np.abs(lam0))))
+    res = linprog(np.r_[np.zeros(k), -1.0], A_ub=np.array(rows), b_ub=np.array(rhs),
+                  bounds=[(-1e3 * scale, 1e3 * scale)] * k + [(None, scale)], method="highs")
+    if res.status != 0:
+        return lam0
+    return lam0 + Z @ res.x[:k]
