@@ -90,13 +90,28 @@ def make_parser() -> argparse.ArgumentParser:
                          description="Simulate the tilted rod with two balls released on a plane with dry friction.")
     _add_physics(sim)
     num = sim.add_argument_group("numerics")
-    num.add_argument("--method", default="event-driven", help="event-driven (default) or moreau-jean")
+    num.add_argument("--method", default="event-driven",
+                     help="event-driven (default), moreau-jean, or the baselines regularized and switched")
     num.add_argument("--h", type=_float, default=1e-4, help="Moreau–Jean step size, s (default 1e-4)")
     num.add_argument("--solver", default="lemke", help="Moreau–Jean one-step solver (default lemke)")
     num.add_argument("--theta", type=_float, default=0.5, help="Moreau–Jean θ in [0.5, 1] (default 0.5)")
     num.add_argument("--min-phase", type=_float, default=None,
                      help="Moreau–Jean: merge phases shorter than this, s (default 2h)")
-    num.add_argument("--rtol", type=_float, default=1e-12, help="event-driven tolerance (default 1e-12)")
+    num.add_argument("--rtol", type=_float, default=None,
+                     help="relative tolerance (default: event-driven 1e-12, regularized/switched 1e-6)")
+    num.add_argument("--atol", type=_float, default=None, help="regularized/switched: absolute tolerance (default rtol·1e-3)")
+    num.add_argument("--epsilon", type=_float, default=1e-4,
+                     help="regularized: regularisation (stiction transition) velocity ε, m/s (default 1e-4)")
+    num.add_argument("--friction-curve", default="stribeck", help="regularized: stribeck (default), tanh or linear")
+    num.add_argument("--ode-method", default=None,
+                     help="regularized: RK45 (default), DOP853, Radau, BDF, LSODA; switched: rk4 (default, step --h) "
+                          "or one of those")
+    num.add_argument("--stiffness", type=_float, default=None,
+                     help="regularized: penalty contact stiffness, N/m^1.5 (default 2e10, Hertz steel)")
+    num.add_argument("--damping", type=_float, default=None,
+                     help="regularized: Hunt–Crossley damping α, s/m (default 500)")
+    num.add_argument("--time-limit", type=_float, default=None,
+                     help="regularized/switched: stop after this many wall-clock seconds (status time-limit)")
     num.add_argument("--t-end", type=_float, default=None,
                      help="end time, s (default: stop at ball B's impact; with it, continue after the impact)")
     out = sim.add_argument_group("output")
@@ -154,7 +169,9 @@ def cmd_simulate(args) -> int:
         if args.solver not in available_solvers():
             raise InputError(f"unknown solver '{args.solver}'; choose from: {', '.join(available_solvers())}")
     run = simulate(problem, args.method, t_end=args.t_end, h=args.h, solver=args.solver, theta=args.theta,
-                   min_phase=args.min_phase, rtol=args.rtol)
+                   min_phase=args.min_phase, rtol=args.rtol, atol=args.atol, epsilon=args.epsilon,
+                   friction_curve=args.friction_curve, ode_method=args.ode_method, stiffness=args.stiffness,
+                   damping=args.damping, time_limit=args.time_limit)
     out_dir = Path(args.out)
     summary = run.summary()
     write_csv(out_dir / "trajectory.csv", run.table, TRAJECTORY_COLUMNS)

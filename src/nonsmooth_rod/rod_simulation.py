@@ -16,7 +16,7 @@ from .results import Phase, SimulationResult
 from .rod_hypotheses import RollingHypothesis, rolling_hypothesis
 from .validation import InputError, require_positive
 
-METHODS = ("event-driven", "moreau-jean")
+METHODS = ("event-driven", "moreau-jean", "regularized", "switched")
 TRAJECTORY_COLUMNS = ("t", "theta", "theta_dot", "theta_ddot", "x_O", "x_O_dot", "x_O_ddot", "N", "T", "mode")
 SUMMARY_SCHEMA = "nonsmooth-rod/summary/1"
 MAX_DURATION = 10.0  # s; without --t-end the run stops at ball B's impact, well before this
@@ -84,8 +84,18 @@ def _impact_of_b(problem: RodProblem, result: SimulationResult) -> dict | None:
 
 def simulate(problem: RodProblem | None = None, method: str = "event-driven", *, t_end: float | None = None,
              h: float = 1e-4, solver: str = "lemke", theta: float = 0.5, min_phase: float | None = None,
-             rtol: float = 1e-12, output_dt: float = 1e-3) -> RodRun:
-    """Simulate the paper's rod. Without `t_end` the run stops at ball B's impact."""
+             rtol: float | None = None, output_dt: float = 1e-3, epsilon: float = 1e-4,
+             friction_curve: str = "stribeck", ode_method: str | None = None, atol: float | None = None,
+             stiffness: float | None = None, damping: float | None = None,
+             time_limit: float | None = None) -> RodRun:
+    """Simulate the paper's rod. Without `t_end` the run stops at ball B's impact.
+
+    `rtol` defaults per method (event-driven 1e-12, regularized and switched 1e-6). The
+    baselines: "regularized" (friction curve `friction_curve` of width `epsilon`, penalty contact
+    of `stiffness`/`damping`, scipy `ode_method`, atol default rtol·1e-3) and "switched" (the
+    paper's sgn(v_C) equations, `ode_method` "rk4" with step h or an adaptive scipy method);
+    `time_limit` (wall seconds) stops either with status "time-limit".
+    """
     problem = problem or RodProblem.paper()
     if method not in METHODS:
         raise InputError(f"unknown method '{method}'; choose from: {', '.join(METHODS)}")
@@ -96,16 +106,39 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
     scene = problem.scene()
     q0, v0 = problem.initial_state()
     if method == "event-driven":
+        rtol = 1e-12 if rtol is None else rtol
         require_positive("rtol", rtol)
         integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, stop_at_impact=stop,
                                                     output_dt=output_dt))
         settings = {"rtol": rtol, "output_dt": output_dt}
+    elif method == "regularized":
+        from .integrators.regularized import Regularized, RegularizedOptions
+        rtol = 1e-6 if rtol is None else rtol
+        extra = {k: v for k, v in (("stiffness", stiffness), ("damping", damping)) if v is not None}
+        integrator = Regularized(RegularizedOptions(
+            epsilon=epsilon, friction_curve=friction_curve, ode_method=ode_method or "RK45", rtol=rtol,
+            atol=rtol * 1e-3 if atol is None else atol, stop_at_impact=stop, output_dt=output_dt,
+            time_limit=time_limit, **({"min_phase": min_phase} if min_phase is not None else {}), **extra))
+        o = integrator.options
+        settings = {"epsilon": o.epsilon, "friction_curve": o.friction_curve, "ode_method": o.ode_method,
+                    "rtol": o.rtol, "atol": o.atol, "contact_model": o.contact_model, "stiffness": o.stiffness,
+                    "damping": o.damping, "stick_velocity": o.stick_velocity, "min_phase": o.min_phase}
+    elif method == "switched":
+        from .integrators.switched import SwitchedOptions, SwitchedRod
+        rtol = 1e-6 if rtol is None else rtol
+        integrator = SwitchedRod(SwitchedOptions(
+            integrator=ode_method or "rk4", h=h, rtol=rtol, atol=rtol * 1e-3 if atol is None else atol,
+            output_dt=output_dt, time_limit=time_limit))
+        settings = {"integrator": integrator.options.integrator, "h": h, "rtol": rtol}
     else:
         from .integrators.moreau_jean import MoreauJean, MoreauJeanOptions
         integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, stop_at_impact=stop,
                                                   min_phase=min_phase))
         settings = {"h": h, "theta": theta, "solver": solver, "min_phase": integrator.options.min_phase}
-    result = integrator.run(scene, q0, v0, duration)
+    if method == "switched":  # the paper's equations of the rod itself, not a scene
+        result = integrator.run(problem, duration)
+    else:
+        result = integrator.run(scene, q0, v0, duration)
     if t_end is None and result.status == "ok" and not any(i.contact == "B" for i in result.impacts):
         result.status = "no-impact"
         result.message = f"ball B did not strike the plane within {MAX_DURATION:g} s"

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -232,6 +233,14 @@ class Regularized:
 
     # ------------------------------------------------------------------ main loop
     def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
+        """Integrate from (q0, v0) to t_end (or the stop contact's touchdown)."""
+        # Implicit methods try states far off the solution (rejected steps, Jacobian columns):
+        # their overflows are not results. A non-finite accepted state ends the run as "nan".
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return self._run(scene, q0, v0, t_end)
+
+    def _run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
         require_positive("t_end", t_end)
         o = self.options
         for c in scene.contacts:
