@@ -41,6 +41,9 @@ class EventDrivenOptions:
     atol: float = 1e-12
     method: str = "DOP853"
     output_dt: float = 1e-3  # spacing of the saved samples (events are always saved)
+    # Events are seen as sign changes between steps: a loose tolerance lets DOP853 step clean
+    # over a short excursion (case 2's T/N > μs lasts 0.1 s) and miss it. Cap the step.
+    max_step: float = 1e-2
     stop_at_impact: str | None = None  # name of a contact whose first impact ends the run
     max_events: int = 10_000
     zeno_interval: float = 1e-9  # impacts closer than this in time: an accumulation point
@@ -52,6 +55,7 @@ class EventDrivenOptions:
         require_positive("rtol", self.rtol)
         require_positive("atol", self.atol)
         require_positive("output_dt", self.output_dt)
+        require_positive("max_step", self.max_step)
 
 
 class _Stop(Exception):
@@ -327,6 +331,7 @@ class EventDriven:
                     return np.concatenate([vv, a])
 
                 sol = solve_ivp(rhs, (t, t_end), y0, method=opts.method, rtol=opts.rtol, atol=opts.atol,
+                                max_step=opts.max_step,
                                 events=funcs or None, dense_output=True)
                 steps += int(sol.t.size - 1)
                 nfev += int(sol.nfev)
