@@ -36,7 +36,7 @@ def unit(angle):
     return (float(np.cos(angle)), float(np.sin(angle)))
 
 
-finite = dict(allow_nan=False, allow_infinity=False)
+finite = dict(allow_nan=False, allow_infinity=False, allow_subnormal=False)
 
 
 @st.composite

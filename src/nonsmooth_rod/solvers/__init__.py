@@ -26,25 +26,21 @@ from .problem import (
 EXACT_SOLVERS = ("lemke", "pgs", "enum")
 
 
-def _solve_lemke(problem, **options):
-    from .lemke import lemke_friction
-
-    return lemke_friction(problem, **options)
-
-
-def _solve_pgs(problem, **options):
-    from .gauss_seidel import projected_gauss_seidel
-
-    return projected_gauss_seidel(problem, **options)
-
-
-def _solve_enum(problem, **options):
-    from .enumeration import enumerate_modes
-
-    return enumerate_modes(problem, **options)
+def _exact_solver(name: str):
+    """The exact solver's function, imported on first use (lemke pulls in numba) and cached."""
+    function = _EXACT_LOADED.get(name)
+    if function is None and name in EXACT_SOLVERS:
+        if name == "lemke":
+            from .lemke import lemke_friction as function
+        elif name == "pgs":
+            from .gauss_seidel import projected_gauss_seidel as function
+        else:
+            from .enumeration import enumerate_modes as function
+        _EXACT_LOADED[name] = function
+    return function
 
 
-_EXACT = {"lemke": _solve_lemke, "pgs": _solve_pgs, "enum": _solve_enum}
+_EXACT_LOADED: dict = {}
 
 
 def available_solvers() -> list[str]:
@@ -67,7 +63,7 @@ def solve(problem: PlanarFrictionProblem, solver: str = "lemke", **options) -> C
     "open" | "stick" | "slip+" | "slip-"). Raises SolverError subclasses on failure and
     ValueError for an unknown solver name.
     """
-    run = _EXACT.get(solver)
+    run = _exact_solver(solver)
     if run is not None:
         return run(problem, **options)
     from .qp import RELAXED_SUFFIX, installed_backends, relaxed_qp, tresca_fixed_point

@@ -27,6 +27,11 @@ def velocities_and_residual(W, q, lo, hi, p):
     return u, residual
 
 
+# Residuals below this count as zero whatever the scale: with subnormal data (|q| ~ 1e-313)
+# tol · scale underflows below the smallest representable residual.
+RESIDUAL_FLOOR = 1e-300
+
+
 def max_abs(*vectors) -> float:
     """Max-norm over several float sequences (0 for empty)."""
     return max((max(map(abs, v), default=0.0) for v in vectors), default=0.0)

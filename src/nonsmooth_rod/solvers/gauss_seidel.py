@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import make_solution, relative_floor, velocities_and_residual
+from ._common import RESIDUAL_FLOOR, make_solution, relative_floor, velocities_and_residual
 from .problem import NoConvergence, PlanarFrictionProblem
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
@@ -94,7 +94,7 @@ def projected_gauss_seidel(
                 p[N], p[T] = solution
         u, residual = velocities_and_residual(W, q, lo, hi, p)
         scale = relative_floor(p, u, q)
-        if residual <= tol * scale:
+        if residual <= tol * scale + RESIDUAL_FLOOR:
             return make_solution(problem, p, u, "pgs", sweep, residual)
     raise NoConvergence(
         f"pgs: no convergence after {max_iter} sweeps, residual {residual:.3e} > "

@@ -119,29 +119,29 @@ def _nearly_solved(backend: str, solution) -> bool:
 
 
 def _tresca_constraints(problem: PlanarFrictionProblem, bound: np.ndarray):
-    """G p ≤ h for p_N ≥ 0 and p_T ∈ [lo·b, hi·b]; a collapsed interval becomes p_T = lo·b."""
-    n_c, n = problem.n_contacts, 2 * problem.n_contacts
-    G_rows, h, A_rows, b = [], [], [], []
-    for i in range(n_c):
+    """(G, h, A, b): G p ≤ h for p_N ≥ 0 and p_T ∈ [lo·b, hi·b]; where the interval has
+    collapsed (b = 0 on the first iteration, or lo = hi) the row becomes A p = b instead."""
+    n = 2 * problem.n_contacts
+    inequalities = []  # (column, coefficient, right-hand side)
+    equalities = []  # (column, right-hand side)
+    for i in range(problem.n_contacts):
         N, T = 2 * i, 2 * i + 1
-        G_rows.append((N, -1.0)), h.append(0.0)
+        inequalities.append((N, -1.0, 0.0))
         low, high = problem.lo[i] * bound[i], problem.hi[i] * bound[i]
         if high > low:
-            G_rows.append((T, 1.0)), h.append(high)
-            G_rows.append((T, -1.0)), h.append(-low)
+            inequalities += [(T, 1.0, high), (T, -1.0, -low)]
         else:
-            A_rows.append(T), b.append(low)
-    G = np.zeros((len(G_rows), n))
-    for row, (column, value) in enumerate(G_rows):
-        G[row, column] = value
-    A = None
-    if A_rows:
-        A = np.zeros((len(A_rows), n))
-        A[np.arange(len(A_rows)), A_rows] = 1.0
-        b = np.array(b)
-    else:
-        b = None
-    return G, np.array(h), A, b
+            equalities.append((T, low))
+    G = np.zeros((len(inequalities), n))
+    for row, (column, coefficient, _) in enumerate(inequalities):
+        G[row, column] = coefficient
+    h = np.array([rhs for _, _, rhs in inequalities])
+    if not equalities:
+        return G, h, None, None
+    A = np.zeros((len(equalities), n))
+    for row, (column, _) in enumerate(equalities):
+        A[row, column] = 1.0
+    return G, h, A, np.array([rhs for _, rhs in equalities])
 
 
 def _relaxed_constraints(problem: PlanarFrictionProblem):
@@ -173,6 +173,33 @@ def relaxed_residual(problem: PlanarFrictionProblem, p) -> float:
     )
 
 
+def _normalised(problem: PlanarFrictionProblem):
+    """(problem with W / max|W| and q / max|q|, factor back to impulses).
+
+    The backends' tolerances are absolute, so they act on O(1) data; the step law is
+    invariant under this scaling: p = p̃ · max|q| / max|W| and u = ũ · max|q|.
+    """
+    W_norm = float(np.max(np.abs(problem.W))) or 1.0
+    q_norm = float(np.max(np.abs(problem.q))) or 1.0
+    scaled = PlanarFrictionProblem(problem.W / W_norm, problem.q / q_norm, problem.lo, problem.hi)
+    return scaled, q_norm / W_norm
+
+
+def _nothing_pushes(problem: PlanarFrictionProblem) -> bool:
+    """q_N ≥ 0 everywhere: p = 0 solves the step (no contact needs to push). Handled exactly
+    rather than by a QP, whose interior-point answer would be 0 only to its tolerance."""
+    return bool(np.all(problem.q[0::2] >= 0.0))
+
+
+def _check(problem, p, check_tol, what, residual_of=complementarity_residual):
+    u = problem.W @ p + problem.q
+    scale = relative_floor(p.tolist(), u.tolist(), problem.q.tolist())
+    residual = residual_of(problem, p)
+    if not residual <= check_tol * scale:
+        raise NoConvergence(f"{what}: residual {residual:.3e} > check_tol {check_tol:.0e} × scale {scale:.3e}")
+    return u, residual
+
+
 def tresca_fixed_point(
     problem: PlanarFrictionProblem,
     *,
@@ -184,37 +211,40 @@ def tresca_fixed_point(
 ):
     """Coulomb step as the fixed point of Tresca QPs (module docstring); ContactSolution.
 
-    ``tol``: stop when max|p_N − b| ≤ tol · residual_scale. ``max_iter``: QP solves before
-    NoConvergence. ``check_tol``: the final solution must have complementarity_residual ≤
-    check_tol · residual_scale (QP accuracy), else NoConvergence. A QP the backend cannot
-    solve raises InfeasibleProblem. iterations = QP solves.
+    ``tol``: stop when max|p_N − b| ≤ tol · residual_scale (of the normalised problem, see
+    `_normalised`). ``max_iter``: QP solves before NoConvergence. ``check_tol``: the final
+    solution must have complementarity_residual ≤ check_tol · residual_scale (QP accuracy),
+    else NoConvergence. A QP the backend cannot solve raises InfeasibleProblem.
+    iterations = QP solves (0 when q_N ≥ 0 and p = 0 is returned directly).
     """
+    if _nothing_pushes(problem):
+        return make_solution(problem, np.zeros_like(problem.q), problem.q.copy(), backend, 0, 0.0)
     options = _backend_options(backend, backend_options)
-    W, q = problem.W, problem.q
+    scaled, to_impulse = _normalised(problem)
+    W, q = scaled.W, scaled.q
     bound = np.zeros(problem.n_contacts)
     p = None
     change = np.inf
     for iteration in range(1, max_iter + 1):
-        G, h, A, b = _tresca_constraints(problem, bound)
+        G, h, A, b = _tresca_constraints(scaled, bound)
         p = _solve_qp(backend, W, q, G, h, A, b, options, p, f"Tresca QP {iteration}")
         p_n = p[0::2]
         change = float(np.max(np.abs(p_n - bound), initial=0.0))
         bound = np.maximum(p_n, 0.0)
-        u = W @ p + q
-        scale = relative_floor(p.tolist(), u.tolist(), q.tolist())
+        scale = relative_floor(p.tolist(), (W @ p + q).tolist(), q.tolist())
         if change <= tol * scale:
-            residual = complementarity_residual(problem, p)
-            if not residual <= check_tol * scale:
-                raise NoConvergence(
-                    f"{backend}: Tresca fixed point settled after {iteration} QPs but its residual "
-                    f"{residual:.3e} > check_tol {check_tol:.0e} × scale {scale:.3e}"
-                )
+            p = p * to_impulse
+            u, residual = _check(
+                problem, p, check_tol, f"{backend}: Tresca fixed point settled after {iteration} QPs but"
+            )
             return make_solution(
-                problem, p, u, backend, iteration, residual, state_tol=STATE_TOL, normal_change=change
+                problem, p, u, backend, iteration, residual, state_tol=STATE_TOL,
+                normal_change=change * to_impulse,
             )
     raise NoConvergence(
         f"{backend}: Tresca fixed point not converged after {max_iter} QPs: normal impulse still "
-        f"changes by {change:.3e}, residual {complementarity_residual(problem, p):.3e}"
+        f"changes by {change * to_impulse:.3e}, residual "
+        f"{complementarity_residual(problem, p * to_impulse):.3e}"
     )
 
 
@@ -229,21 +259,20 @@ def relaxed_qp(
 
     ``residual`` is the common (step-law) residual, which the relaxation's artefact makes
     nonzero on sliding contacts; info["relaxed_residual"] is the residual of the law it does
-    solve, which must be ≤ check_tol · residual_scale (else NoConvergence).
+    solve, which must be ≤ check_tol · residual_scale (else NoConvergence). iterations = 1
+    (0 when q_N ≥ 0 and p = 0 is returned directly).
     """
+    name = backend + RELAXED_SUFFIX
+    if _nothing_pushes(problem):
+        return make_solution(problem, np.zeros_like(problem.q), problem.q.copy(), name, 0, 0.0,
+                             relaxed_residual=0.0)
     options = _backend_options(backend, backend_options)
-    G, h = _relaxed_constraints(problem)
-    p = _solve_qp(backend, problem.W, problem.q, G, h, None, None, options, None, "relaxed QP")
-    u = problem.W @ p + problem.q
-    scale = relative_floor(p.tolist(), u.tolist(), problem.q.tolist())
-    relaxed = relaxed_residual(problem, p)
-    if not relaxed <= check_tol * scale:
-        raise NoConvergence(
-            f"{backend}{RELAXED_SUFFIX}: QP solution misses the relaxed law, residual "
-            f"{relaxed:.3e} > check_tol {check_tol:.0e} × scale {scale:.3e}"
-        )
+    scaled, to_impulse = _normalised(problem)
+    G, h = _relaxed_constraints(scaled)
+    p = _solve_qp(backend, scaled.W, scaled.q, G, h, None, None, options, None, "relaxed QP") * to_impulse
+    u, relaxed = _check(problem, p, check_tol, f"{name}: QP solution misses the relaxed law,", relaxed_residual)
     return make_solution(
-        problem, p, u, backend + RELAXED_SUFFIX, 1, complementarity_residual(problem, p),
+        problem, p, u, name, 1, complementarity_residual(problem, p),
         state_tol=STATE_TOL, relaxed_residual=relaxed,
     )
 
