@@ -88,7 +88,10 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         iterations += sol.iterations
         p, u = sol.p, sol.u
         scale_p = max(1e-300, float(np.max(np.abs(p))))
-        states, implied, ok = classify(p, u, mu_s, velocity_tol, 1e-12 * scale_p)
+        # A slip velocity within the solver's own accuracy is zero (iterative and QP
+        # solvers leave residuals of 1e-12..1e-9; Lemke's is round-off).
+        step_velocity_tol = max(velocity_tol, 10.0 * sol.residual)
+        states, implied, ok = classify(p, u, mu_s, step_velocity_tol, 1e-12 * scale_p)
         # A guess is consistent for a contact when the step slid the way the guess said, or
         # stuck inside the static cone (any guess), or opened.
         for i, st in enumerate(states):
@@ -114,7 +117,8 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         if tuple(zero) not in tried:
             problem = PlanarFrictionProblem(W, q, -mu_s, mu_s)
             sol = _solvers.solve(problem, solver, **(solver_options or {}))
-            states, implied, _ = classify(sol.p, sol.u, mu_s, velocity_tol, 1e-12 * max(1e-300, np.max(np.abs(sol.p))))
+            states, implied, _ = classify(sol.p, sol.u, mu_s, max(velocity_tol, 10.0 * sol.residual),
+                                          1e-12 * max(1e-300, np.max(np.abs(sol.p))))
             best = StepContactResult(sol.p, sol.u, states, zero, best.solves + 1,
                                      iterations + sol.iterations, sol.residual, False)
     return best

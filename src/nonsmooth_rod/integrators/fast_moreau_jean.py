@@ -116,6 +116,7 @@ def _attempt(W, qv, mu_s, mu_d, guess, v_tol):
     new_guess = guess.copy()
     if not accepted:
         return False, p, u, st, False, new_guess
+    v_tol = max(v_tol, 10.0 * residual)  # as onestep: within the solver's accuracy is zero
     scale_p = 1e-300
     for r_ in range(m):
         scale_p = max(scale_p, abs(p[r_]))

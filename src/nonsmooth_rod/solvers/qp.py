@@ -200,6 +200,41 @@ def _check(problem, p, check_tol, what, residual_of=complementarity_residual):
     return u, residual
 
 
+def _polish_active_set(problem: PlanarFrictionProblem, p: np.ndarray) -> np.ndarray:
+    """Re-solve exactly the linear system of the contact modes the QP solution shows.
+
+    Interior-point and ADMM backends stop at ~1e-9 relative accuracy, and less on degenerate
+    steps (a contact sliding exactly at an end of its interval, as at break-away). Reading the
+    active set off the approximate solution and solving that mode's equations exactly (as the
+    enumeration solver does for every mode) removes the error; the polished point is kept
+    only if it satisfies the law better.
+    """
+    import itertools
+
+    from .enumeration import OPEN, SLIP_NEG, SLIP_POS, STICK, _solve_modes
+
+    u = problem.W @ p + problem.q
+    p_scale = max(float(np.max(np.abs(p))), 1e-300)
+    # Per contact the modes the approximate point is near: open, or stick / slip the way u_T
+    # points (near-degenerate steps sit between the two); every combination is solved exactly
+    # and the one obeying the law best is kept.
+    choices = []
+    for i in range(problem.n_contacts):
+        if p[2 * i] <= 1e-9 * p_scale:
+            choices.append([OPEN])
+        else:
+            choices.append([STICK, SLIP_POS if u[2 * i + 1] >= 0.0 else SLIP_NEG])
+    modes = np.array(list(itertools.product(*choices)))
+    candidates = _solve_modes(problem, modes, 1e-12)
+    best, best_residual = p, complementarity_residual(problem, p)
+    for candidate in candidates:
+        if np.all(np.isfinite(candidate)):
+            residual = complementarity_residual(problem, candidate)
+            if residual < best_residual:
+                best, best_residual = candidate, residual
+    return best
+
+
 def tresca_fixed_point(
     problem: PlanarFrictionProblem,
     *,
@@ -233,7 +268,7 @@ def tresca_fixed_point(
         bound = np.maximum(p_n, 0.0)
         scale = relative_floor(p.tolist(), (W @ p + q).tolist(), q.tolist())
         if change <= tol * scale:
-            p = p * to_impulse
+            p = _polish_active_set(problem, p * to_impulse)
             u, residual = _check(
                 problem, p, check_tol, f"{backend}: Tresca fixed point settled after {iteration} QPs but"
             )
