@@ -55,7 +55,8 @@ class EventDrivenOptions:
         require_positive("rtol", self.rtol)
         require_positive("atol", self.atol)
         require_positive("output_dt", self.output_dt)
-        require_positive("max_step", self.max_step)
+        if not (isinstance(self.max_step, (int, float)) and self.max_step > 0):  # inf: no cap
+            raise InputError(f"max_step must be positive, got {self.max_step!r}")
 
 
 class _Stop(Exception):
