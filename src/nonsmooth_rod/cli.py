@@ -32,6 +32,13 @@ def _float(text: str) -> float:
         raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
 
 
+def _int(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+
+
 def _add_physics(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("physics (defaults: the paper's case 2)")
     g.add_argument("--mu-s", type=_float, default=0.28, help="static friction coefficient μs (default 0.28)")

@@ -18,15 +18,8 @@ Painlevé/Zeno and Moreau–Jean's θ). Every run has a wall-clock limit, at mos
 The full study takes about 4 minutes on 2 cores; --quick about 10 s."""
 
 
-def _int(text: str) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-
-
 def register(subparsers) -> None:
-    from ..cli import _float
+    from ..cli import _float, _int
 
     p = subparsers.add_parser("benchmark", help="work–precision chart and stability study of every method",
                               description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..cli import _int
 from ..validation import InputError
 
 DESCRIPTION = """\
@@ -14,13 +15,6 @@ characteristic times; θ, θ̇, θ̈, x_O, ẋ_O, ẍ_O, N and the actual T/N, r
 --frames/--gif draw the rod itself; --paper-figures writes the Figs. 18-25 set (three friction
 cases, rolling vs sliding hypotheses, angular velocity near the impact) for the folder's body
 (or, without a folder, for the paper's)."""
-
-
-def _int(text: str) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
 
 
 def _formats(text: str) -> tuple[str, ...]:

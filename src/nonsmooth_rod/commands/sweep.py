@@ -17,15 +17,8 @@ included), a,b,c or one number. Rows are appended as they finish: rerunning an i
 sweep with the same --out computes only the missing points."""
 
 
-def _int(text: str) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-
-
 def register(subparsers) -> None:
-    from ..cli import _float, add_physics_options
+    from ..cli import _float, _int, add_physics_options
 
     # The shared physics options define --mu-s/--mu-d/--theta0-deg as single numbers; here they
     # are ranges, so this parser resolves the clash in favour of the definitions below.
