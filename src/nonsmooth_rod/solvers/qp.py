@@ -287,7 +287,7 @@ def relaxed_qp(
     problem: PlanarFrictionProblem,
     *,
     backend: str = "osqp",
-    check_tol: float = 1e-7,
+    check_tol: float = 1e-6,  # one unpolished QP: interior-point accuracy on degenerate steps
     **backend_options,
 ):
     """The convex relaxation as one QP (module docstring); ContactSolution named backend-relaxed.
