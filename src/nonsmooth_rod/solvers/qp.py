@@ -235,6 +235,46 @@ def _polish_active_set(problem: PlanarFrictionProblem, p: np.ndarray) -> np.ndar
     return best
 
 
+def _polish_relaxed(problem: PlanarFrictionProblem, p: np.ndarray) -> np.ndarray:
+    """The relaxed QP's active set, re-solved exactly (see _polish_active_set).
+
+    Its KKT conditions per contact: open (p = 0); inside the cone (u_N = u_T = 0); or on an
+    edge p_T = e p_N (e = lo or hi) with u_N + e u_T = 0 — the relaxation's spurious normal
+    velocity u_N = −e u_T.
+    """
+    import itertools
+
+    W, q = problem.W, problem.q
+    n = q.shape[0]
+    u = W @ p + q
+    p_scale = max(float(np.max(np.abs(p))), 1e-300)
+    choices = []
+    for i in range(problem.n_contacts):
+        if p[2 * i] <= 1e-9 * p_scale:
+            choices.append(["open"])
+        else:
+            choices.append(["inside", "lo" if u[2 * i + 1] >= 0.0 else "hi"])
+    best, best_residual = p, relaxed_residual(problem, p)
+    for modes in itertools.product(*choices):
+        A = np.zeros((n, n))
+        b = np.zeros(n)
+        for i, mode in enumerate(modes):
+            N, T = 2 * i, 2 * i + 1
+            if mode == "open":
+                A[N, N] = A[T, T] = 1.0
+            elif mode == "inside":
+                A[N], A[T], b[N], b[T] = W[N], W[T], -q[N], -q[T]
+            else:
+                edge = problem.lo[i] if mode == "lo" else problem.hi[i]
+                A[N], b[N] = W[N] + edge * W[T], -(q[N] + edge * q[T])
+                A[T, T], A[T, N] = 1.0, -edge
+        candidate = np.linalg.lstsq(A, b, rcond=1e-12)[0]
+        residual = relaxed_residual(problem, candidate)
+        if np.all(np.isfinite(candidate)) and residual < best_residual:
+            best, best_residual = candidate, residual
+    return best
+
+
 def tresca_fixed_point(
     problem: PlanarFrictionProblem,
     *,
@@ -287,7 +327,7 @@ def relaxed_qp(
     problem: PlanarFrictionProblem,
     *,
     backend: str = "osqp",
-    check_tol: float = 1e-6,  # one unpolished QP: interior-point accuracy on degenerate steps
+    check_tol: float = 1e-7,
     **backend_options,
 ):
     """The convex relaxation as one QP (module docstring); ContactSolution named backend-relaxed.
@@ -305,6 +345,7 @@ def relaxed_qp(
     scaled, to_impulse = _normalised(problem)
     G, h = _relaxed_constraints(scaled)
     p = _solve_qp(backend, scaled.W, scaled.q, G, h, None, None, options, None, "relaxed QP") * to_impulse
+    p = _polish_relaxed(problem, p)
     u, relaxed = _check(problem, p, check_tol, f"{name}: QP solution misses the relaxed law,", relaxed_residual)
     return make_solution(
         problem, p, u, name, 1, complementarity_residual(problem, p),
