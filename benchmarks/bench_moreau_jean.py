@@ -54,6 +54,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--quick", action="store_true", help="3 repeats, h = 1e-3, exact solvers only")
+    parser.add_argument("--solvers", default=None, help="comma-separated subset of the solvers (default: all)")
     args = parser.parse_args(argv)
     repeats = 3 if args.quick else args.repeats
     h = 1e-3 if args.quick else 1e-4
@@ -64,6 +65,9 @@ def main(argv=None) -> int:
     rows = [("lemke (compiled run)", "lemke", True)]
     rows += [(name, name, False) for name in available_solvers()
              if not (args.quick and (name.endswith("-relaxed") or name not in ("lemke", "pgs", "enum")))]
+    if args.solvers:
+        wanted = set(args.solvers.split(","))
+        rows = [row for row in rows if row[1] in wanted]
     for label, solver, fast in rows:
         us, steps, status = step_us(solver, h=h, repeats=repeats, fast=fast)
         note = "" if status == "ok" else f"  FAILED: {status}"
