@@ -1,4 +1,4 @@
-"""Command line: `nonsmooth-rod simulate` (and the other studies as they land).
+"""Nonsmooth contact dynamics of the tilted two-ball rod: simulate, plot, sweep, benchmark.
 
 Every mistake in the input ends with one line on stderr and exit status 2; a run that fails
 (solver failure, Painlevé stop) still writes its files and exits with status 1.
