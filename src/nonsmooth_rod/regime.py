@@ -73,16 +73,9 @@ def phases_text(phases) -> str:
 
 def scenario_of(phases, status: str = "ok") -> str:
     """The paper's scenario from ball A's phase sequence; the status word if the run failed."""
-    if status != "ok":
-        return status
-    modes = [ph.mode for ph in phases]
-    if not modes:
-        return "failed"
-    if modes[0] != "stick":
-        return "slide-at-start"
-    if len(modes) == 1:
-        return "roll-to-impact"
-    return {"slip-": "roll-until-r1", "slip+": "roll-until-r2"}.get(modes[1], f"roll-then-{modes[1]}")
+    from .rod_simulation import scenario
+
+    return status if status != "ok" else scenario(phases)
 
 
 def classify_point(base: RodProblem, mu_s: float, mu_d: float, theta0_deg: float,

@@ -150,12 +150,12 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
 
 
 def scenario(phases: list[Phase]) -> str:
-    """The paper's scenario of a run from its phase sequence (used by the regime map)."""
+    """The paper's scenario of a run from ball A's phase sequence (the regime map's classes)."""
     modes = [p.mode for p in phases]
     if not modes:
-        return "unknown"
+        return "failed"
     if modes[0] != "stick":
         return "slide-at-start"
     if len(modes) == 1:
         return "roll-to-impact"
-    return "roll-until-r1" if modes[1] == "slip-" else "roll-until-r2"
+    return {"slip-": "roll-until-r1", "slip+": "roll-until-r2"}.get(modes[1], f"roll-then-{modes[1]}")
