@@ -76,6 +76,27 @@ def _corners(body: int, width: float, height: float, line: Line, law: ContactLaw
             PointOnLine(body, (a, -b), line, law, name="right")]
 
 
+def _block_scene(toy, applied_force=None) -> Scene:
+    """A toy's width × height block on its `line`, both bottom corners with its μs/μd, e = 0."""
+    body = RigidBody(toy.mass, _rectangle_inertia(toy.mass, toy.width, toy.height), name="block")
+    law = ContactLaw.of(toy.mu_s, toy.mu_d, 0.0)
+    return Scene([body], _corners(0, toy.width, toy.height, toy.line, law), gravity=toy.g,
+                 applied_force=applied_force)
+
+
+def _force_along_floor(height: float, magnitude):
+    """Applied force `magnitude(t, q)` along +x acting at the block's bottom face (the floor
+    line), so it neither pitches the block nor unloads one corner."""
+    b = height / 2
+
+    def applied(t, q, v):
+        force = (magnitude(t, q), 0.0)
+        lever = rotate(q[2], (0.0, -b))  # from the centre of mass to the floor line
+        return np.array([force[0], force[1], cross2(lever, force)])
+
+    return applied
+
+
 def _slope_coordinate(result: SimulationResult, angle: float, body: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Position and velocity of a body's centre of mass along a line of inclination `angle`."""
     t = (math.cos(angle), math.sin(angle))
@@ -196,9 +217,7 @@ class BlockOnIncline:
         return Line((0.0, 0.0), self.angle)
 
     def scene(self) -> Scene:
-        body = RigidBody(self.mass, _rectangle_inertia(self.mass, self.width, self.height), name="block")
-        law = ContactLaw.of(self.mu_s, self.mu_d, 0.0)
-        return Scene([body], _corners(0, self.width, self.height, self.line, law), gravity=self.g)
+        return _block_scene(self)
 
     def initial_state(self):
         n, t = self.line.normal, self.line.tangent
@@ -283,17 +302,7 @@ class PushedBlock:
         return self.rate * t
 
     def scene(self) -> Scene:
-        body = RigidBody(self.mass, _rectangle_inertia(self.mass, self.width, self.height), name="block")
-        law = ContactLaw.of(self.mu_s, self.mu_d, 0.0)
-        b = self.height / 2
-
-        def push_along_floor(t, q, v):
-            force = (self.push(t), 0.0)
-            lever = rotate(q[2], (0.0, -b))  # from the centre of mass to the floor line
-            return np.array([force[0], force[1], cross2(lever, force)])
-
-        return Scene([body], _corners(0, self.width, self.height, self.line, law), gravity=self.g,
-                     applied_force=push_along_floor)
+        return _block_scene(self, _force_along_floor(self.height, lambda t, q: self.push(t)))
 
     def initial_state(self):
         return np.array([0.0, self.height / 2, 0.0]), np.zeros(3)
@@ -400,17 +409,7 @@ class BeltOscillator:
         return Line((0.0, 0.0), 0.0, self.belt_speed)
 
     def scene(self) -> Scene:
-        body = RigidBody(self.mass, _rectangle_inertia(self.mass, self.width, self.height), name="block")
-        law = ContactLaw.of(self.mu_s, self.mu_d, 0.0)
-        b = self.height / 2
-
-        def spring_along_belt(t, q, v):
-            force = (-self.stiffness * q[0], 0.0)
-            lever = rotate(q[2], (0.0, -b))
-            return np.array([force[0], force[1], cross2(lever, force)])
-
-        return Scene([body], _corners(0, self.width, self.height, self.line, law), gravity=self.g,
-                     applied_force=spring_along_belt)
+        return _block_scene(self, _force_along_floor(self.height, lambda t, q: -self.stiffness * q[0]))
 
     def initial_state(self):
         return np.array([0.0, self.height / 2, 0.0]), np.array([self.belt_speed, 0.0, 0.0])
