@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
-from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.solvers import available_solvers
 
 

@@ -58,7 +58,7 @@ def _add_physics(p: argparse.ArgumentParser) -> None:
 
 def build_problem(args):
     """RodProblem from parsed options (raises InputError on any inconsistency)."""
-    from .model.rod import RodGeometry, RodProblem
+    from .rod.problem import RodGeometry, RodProblem
 
     common = dict(mu_s=args.mu_s, mu_d=args.mu_d, restitution=args.restitution, g=args.g)
     if not math.isfinite(args.theta0_deg):
@@ -168,7 +168,7 @@ def cmd_simulate(args) -> int:
     from rich.console import Console
 
     from .io import dumps_json, write_csv, write_json
-    from .rod_simulation import TRAJECTORY_COLUMNS, simulate
+    from .rod.simulation import TRAJECTORY_COLUMNS, simulate
 
     problem = build_problem(args)
     if args.method == "moreau-jean":
@@ -184,7 +184,7 @@ def cmd_simulate(args) -> int:
     write_csv(out_dir / "trajectory.csv", run.table, TRAJECTORY_COLUMNS)
     write_json(out_dir / "summary.json", summary)
     if not args.no_plot:
-        from .plotting import plot_run
+        from .rod.plotting import plot_run
         plot_run(run, out_dir / "figure.png")
     if args.json:
         sys.stdout.write(dumps_json(summary))

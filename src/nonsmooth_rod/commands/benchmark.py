@@ -50,7 +50,7 @@ def _parse_list(text: str, what: str, convert=str) -> list:
 def cmd_benchmark(args) -> int:
     from pathlib import Path
 
-    from .. import study
+    from ..rod import study
     from ..io import write_csv, write_text
 
     cases = _parse_list(args.cases, "cases", int)

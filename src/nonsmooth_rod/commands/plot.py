@@ -18,7 +18,7 @@ cases, rolling vs sliding hypotheses, angular velocity near the impact) for the 
 
 
 def _formats(text: str) -> tuple[str, ...]:
-    from ..plotting import FORMATS
+    from ..rod.plotting import FORMATS
 
     fmts = tuple(dict.fromkeys(f.strip().lower() for f in text.split(",") if f.strip()))
     bad = [f for f in fmts if f not in FORMATS]
@@ -55,7 +55,7 @@ def _same_problem(a, b) -> list[str]:
 
 
 def cmd_plot(args) -> int:
-    from ..plotting import frames_figure, lines_and_markers, load_run_dir, panel_figure, save_figure, write_gif
+    from ..rod.plotting import frames_figure, lines_and_markers, load_run_dir, panel_figure, save_figure, write_gif
 
     if args.folder is None and not args.paper_figures:
         raise InputError("give a results folder (from `nonsmooth-rod simulate --out DIR`) or --paper-figures")
@@ -85,8 +85,8 @@ def cmd_plot(args) -> int:
     if data is not None and args.gif:
         written.append(write_gif(data, out_dir / "rod.gif"))
     if args.paper_figures:
-        from ..figures import write_paper_figures
-        from ..model.rod import RodProblem
+        from ..rod.figures import write_paper_figures
+        from ..rod.problem import RodProblem
 
         base = data.problem if data is not None else RodProblem.paper()
         written += write_paper_figures(out_dir, base, args.format, args.dpi)

@@ -47,9 +47,9 @@ def register(subparsers) -> None:
 
 def cmd_sweep(args) -> int:
     from ..cli import build_problem
-    from ..plotting import FORMATS
-    from ..regime import Grid, SweepSettings, default_jobs, parse_range, sweep
-    from ..rod_simulation import METHODS
+    from ..rod.plotting import FORMATS
+    from ..rod.regime import Grid, SweepSettings, default_jobs, parse_range, sweep
+    from ..rod.simulation import METHODS
 
     mu_s = parse_range(args.mu_s, "--mu-s")
     theta0 = parse_range(args.theta0_deg, "--theta0-deg", max_count=200)

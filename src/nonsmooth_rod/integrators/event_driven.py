@@ -28,7 +28,7 @@ from scipy.integrate import solve_ivp
 
 from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
-from ..onestep import solve_two_coefficient
+from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import InputError, require_positive
 

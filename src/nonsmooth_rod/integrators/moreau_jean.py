@@ -23,7 +23,7 @@ import numpy as np
 
 from ..model.scene import Scene
 from . import fast_moreau_jean
-from ..onestep import solve_two_coefficient
+from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..solvers import available_solvers
 from ..solvers.problem import SolverError

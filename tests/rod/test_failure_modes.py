@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from nonsmooth_rod import study
+from nonsmooth_rod.rod import study
 from nonsmooth_rod.cli import main
 from nonsmooth_rod.integrators.moreau_jean import MoreauJeanOptions
-from nonsmooth_rod.model.rod import RodProblem
-from nonsmooth_rod.rod_simulation import simulate
+from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.rod.simulation import simulate
 from nonsmooth_rod.validation import InputError
 
 

@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from nonsmooth_rod.model.rod import RodProblem
-from nonsmooth_rod.rod_hypotheses import rolling_hypothesis, sliding_hypothesis
-from nonsmooth_rod.rod_simulation import scenario, simulate
+from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.rod.hypotheses import rolling_hypothesis, sliding_hypothesis
+from nonsmooth_rod.rod.simulation import scenario, simulate
 
 
 def modes(run):

@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model.rod import PAPER_CASES, RodProblem
-from .results import Phase
-from .validation import InputError
+from .problem import PAPER_CASES, RodProblem
+from ..results import Phase
+from ..validation import InputError
 
 REFERENCE_RTOL = 1e-12
 REFERENCE_DT = 1e-4  # s: the reference's samples, on which x_O errors are taken
@@ -151,7 +151,7 @@ class Reference:
 
 def reference(case: int, problem: RodProblem | None = None) -> Reference:
     """The event-driven solution at its tightest tolerance, sampled every REFERENCE_DT."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     problem = problem or RodProblem.paper(case)
     run = simulate(problem, "event-driven", rtol=REFERENCE_RTOL, output_dt=REFERENCE_DT)
@@ -274,7 +274,7 @@ def _soft_limit(spec: RunSpec, time_limit: float) -> dict:
 
 def run_one(spec: RunSpec, ref: Reference, time_limit: float | None = None) -> dict:
     """Run and measure one spec in this process."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     base = {"method": spec.method, "setting": spec.setting, "case": spec.case, "knob": spec.knob_label,
             "knob_name": spec.knob, "knob_value": spec.value}
@@ -304,7 +304,7 @@ def _child(spec, ref, time_limit, conn):
 def _warm_up(specs) -> None:
     """Compile Moreau–Jean's fast path once here, so forked runs do not pay for it."""
     if any(s.method == "moreau-jean" for s in specs):
-        from .rod_simulation import simulate
+        from .simulation import simulate
         simulate(RodProblem.paper(2), "moreau-jean", h=1e-2, solver="lemke")
 
 
@@ -428,7 +428,7 @@ def plot_work_precision(records: list[dict], path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .io import atomic_path
+    from ..io import atomic_path
 
     palettes = {"event-driven": ["black"],
                 "moreau-jean": ["#08306b", "#17becf", "#6baed6", "#393b79"],
@@ -488,7 +488,7 @@ def bistable_map(epsilons=(1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6), tolerances=(1e-3
 
     The exact solution rolls (T/N = 0.263 at release lies between μd = 0.20 and μs = 0.28) until
     T/N reaches μs at t = 0.1041 s. "rolls" = the first phase sticks for at least 90 % of that."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     ref = reference(2)
     t_break = ref.phases[0].t_end
@@ -539,7 +539,7 @@ def epsilon_study(epsilons=(1e-3, 1e-4, 1e-5), ode_methods=("RK45", "LSODA"), ca
 
     A softer contact than the default (2e8 N/m^1.5) keeps the contact's own stiffness from
     capping the explicit step, so what limits it is the friction curve's slope μ N/ε."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     p = RodProblem.paper(case)
     out = []
@@ -572,7 +572,7 @@ RESTICK_CASE = (0.28, 0.24)  # the reference rolls, slides left, sticks again (0
 
 def switched_study(h_values=(1e-3, 1e-4), adaptive=("RK45",), time_limit: float = 20.0) -> list[dict]:
     """The switched formulation where the reference re-sticks after a slip reversal."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     p = RodProblem.paper(None, mu_s=RESTICK_CASE[0], mu_d=RESTICK_CASE[1])
     ref = reference(0, p)
@@ -606,7 +606,7 @@ def switched_markdown(rows: list[dict]) -> str:
 
 def painleve_and_zeno(h: float = 1e-3) -> dict:
     """Where the event-driven reference stops and Moreau–Jean goes on with bounded energy."""
-    from . import toys
+    from .. import toys
 
     out = {}
     rod = toys.PainleveRod()
@@ -635,8 +635,8 @@ def theta_energy(thetas=(0.3, 0.5, 1.0), h: float = 1e-2, drop_height: float = 1
     """Moreau–Jean's θ and energy: a ball's free fall gains (½ − θ) m g² h² per step.
 
     The default options refuse θ < ½; allow_energy_gain=True runs it for this study."""
-    from . import toys
-    from .integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+    from .. import toys
+    from ..integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 
     ball = toys.BouncingBall(drop_height=drop_height, restitution=0.9)
     scene = ball.scene()

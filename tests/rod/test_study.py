@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from nonsmooth_rod import study
+from nonsmooth_rod.rod import study
 from nonsmooth_rod.cli import main
 from nonsmooth_rod.io import read_csv
 
@@ -102,8 +102,8 @@ def test_bad_benchmark_input_is_one_line(argv, message, tmp_path, capsys):
 
 
 def test_measure_reads_creep_and_impact_error_off_a_run():
-    from nonsmooth_rod.model.rod import RodProblem
-    from nonsmooth_rod.rod_simulation import simulate
+    from nonsmooth_rod.rod.problem import RodProblem
+    from nonsmooth_rod.rod.simulation import simulate
 
     ref = study.reference(3)
     run = simulate(RodProblem.paper(3), "moreau-jean", h=1e-3)

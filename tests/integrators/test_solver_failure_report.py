@@ -2,7 +2,7 @@
 import re
 
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
-from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.rod.problem import RodProblem
 
 
 def test_gauss_seidel_without_iterations_fails_loudly():

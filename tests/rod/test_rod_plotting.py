@@ -9,14 +9,14 @@ import pytest
 from matplotlib.colors import to_rgba
 from PIL import Image
 
-from nonsmooth_rod.figures import (
+from nonsmooth_rod.rod.figures import (
     cases_figure,
     hypotheses_figure,
     impact_detail_figure,
     rolling_series,
 )
-from nonsmooth_rod.model.rod import RodProblem
-from nonsmooth_rod.plotting import (
+from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.rod.plotting import (
     DATA_GID,
     MARKER_GID,
     PANEL_SERIES,
@@ -31,8 +31,8 @@ from nonsmooth_rod.plotting import (
     rod_outline,
     write_gif,
 )
-from nonsmooth_rod.rod_hypotheses import rolling_hypothesis, sliding_hypothesis
-from nonsmooth_rod.rod_simulation import simulate
+from nonsmooth_rod.rod.hypotheses import rolling_hypothesis, sliding_hypothesis
+from nonsmooth_rod.rod.simulation import simulate
 from nonsmooth_rod.validation import InputError
 
 BLUE, RED = to_rgba("tab:blue"), to_rgba("tab:red")

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import solvers as _solvers
-from .solvers.problem import PlanarFrictionProblem, SolverError
+from .. import solvers as _solvers
+from .problem import PlanarFrictionProblem, SolverError
 
 
 @dataclass

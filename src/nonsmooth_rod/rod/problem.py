@@ -18,10 +18,10 @@ from ..validation import (
     require_in_range,
     require_positive,
 )
-from .body import RigidBody
-from .contacts import DiskOnLine, Line
-from .laws import ContactLaw
-from .scene import Scene
+from ..model.body import RigidBody
+from ..model.contacts import DiskOnLine, Line
+from ..model.laws import ContactLaw
+from ..model.scene import Scene
 
 PAPER_CASES = {1: (0.12, 0.10), 2: (0.28, 0.20), 3: (0.40, 0.30)}
 

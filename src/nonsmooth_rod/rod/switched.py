@@ -27,7 +27,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 from scipy.optimize import brentq
 
-from ..model import rod_closed_form as cf
+from . import closed_form as cf
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import InputError, require_nonnegative, require_positive
 

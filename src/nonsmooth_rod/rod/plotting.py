@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from .io import atomic_path, read_csv
-from .model.rod import RodProblem
-from .results import Phase
-from .rod_hypotheses import RollingHypothesis, rolling_hypothesis
-from .validation import InputError
+from ..io import atomic_path, read_csv
+from .problem import RodProblem
+from ..results import Phase
+from .hypotheses import RollingHypothesis, rolling_hypothesis
+from ..validation import InputError
 
 # The paper's colours: sliding red, rolling blue; flight (not in the paper) grey.
 REGIME_COLOURS = {"stick": "tab:blue", "slip+": "tab:red", "slip-": "tab:red", "flight": "tab:gray"}

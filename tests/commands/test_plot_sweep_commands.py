@@ -7,7 +7,7 @@ from PIL import Image
 
 from nonsmooth_rod.cli import main
 from nonsmooth_rod.io import read_csv
-from nonsmooth_rod.plotting import (
+from nonsmooth_rod.rod.plotting import (
     DATA_GID,
     MARKER_GID,
     axis,

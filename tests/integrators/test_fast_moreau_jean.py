@@ -6,7 +6,7 @@ import pytest
 
 from nonsmooth_rod.integrators import fast_moreau_jean
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
-from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.rod.problem import RodProblem
 
 from test_moreau_jean import _block_on_incline
 

@@ -16,9 +16,9 @@ from nonsmooth_rod.integrators.regularized import (
 from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import DiskOnLine, Line
 from nonsmooth_rod.model.laws import ContactLaw
-from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.model.scene import Scene
-from nonsmooth_rod.rod_simulation import simulate
+from nonsmooth_rod.rod.simulation import simulate
 from nonsmooth_rod.validation import InputError
 
 

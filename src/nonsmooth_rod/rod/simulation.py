@@ -10,11 +10,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .integrators.event_driven import EventDriven, EventDrivenOptions
-from .model.rod import RodProblem
-from .results import Phase, SimulationResult
-from .rod_hypotheses import RollingHypothesis, rolling_hypothesis
-from .validation import InputError, require_positive
+from ..integrators.event_driven import EventDriven, EventDrivenOptions
+from .problem import RodProblem
+from ..results import Phase, SimulationResult
+from .hypotheses import RollingHypothesis, rolling_hypothesis
+from ..validation import InputError, require_positive
 
 METHODS = ("event-driven", "moreau-jean", "regularized", "switched")
 TRAJECTORY_COLUMNS = ("t", "theta", "theta_dot", "theta_ddot", "x_O", "x_O_dot", "x_O_ddot", "N", "T", "mode")
@@ -112,7 +112,7 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
                                                     output_dt=output_dt))
         settings = {"rtol": rtol, "output_dt": output_dt}
     elif method == "regularized":
-        from .integrators.regularized import Regularized, RegularizedOptions
+        from ..integrators.regularized import Regularized, RegularizedOptions
         rtol = 1e-6 if rtol is None else rtol
         extra = {k: v for k, v in (("stiffness", stiffness), ("damping", damping)) if v is not None}
         integrator = Regularized(RegularizedOptions(
@@ -124,14 +124,14 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
                     "rtol": o.rtol, "atol": o.atol, "contact_model": o.contact_model, "stiffness": o.stiffness,
                     "damping": o.damping, "stick_velocity": o.stick_velocity, "min_phase": o.min_phase}
     elif method == "switched":
-        from .integrators.switched import SwitchedOptions, SwitchedRod
+        from .switched import SwitchedOptions, SwitchedRod
         rtol = 1e-6 if rtol is None else rtol
         integrator = SwitchedRod(SwitchedOptions(
             integrator=ode_method or "rk4", h=h, rtol=rtol, atol=rtol * 1e-3 if atol is None else atol,
             output_dt=output_dt, time_limit=time_limit))
         settings = {"integrator": integrator.options.integrator, "h": h, "rtol": rtol}
     else:
-        from .integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+        from ..integrators.moreau_jean import MoreauJean, MoreauJeanOptions
         integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, stop_at_impact=stop,
                                                   min_phase=min_phase))
         settings = {"h": h, "theta": theta, "solver": solver, "min_phase": integrator.options.min_phase}

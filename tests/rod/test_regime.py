@@ -7,10 +7,10 @@ import shutil
 import numpy as np
 import pytest
 
-from nonsmooth_rod import regime
-from nonsmooth_rod.model.rod import RodProblem
-from nonsmooth_rod.plotting import axis
-from nonsmooth_rod.regime import (
+from nonsmooth_rod.rod import regime
+from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.rod.plotting import axis
+from nonsmooth_rod.rod.regime import (
     CSV_COLUMNS,
     Grid,
     SweepSettings,
@@ -92,7 +92,7 @@ def test_at_30_degrees_the_start_is_the_maximum_so_no_r1_region(tmp_path):
 
 
 def test_map_cells_and_boundaries(small_sweep):
-    from nonsmooth_rod.regime import regime_map_figure
+    from nonsmooth_rod.rod.regime import regime_map_figure
 
     fig = regime_map_figure(small_sweep.grid_rows, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), BASE,
                             small_sweep.thresholds)

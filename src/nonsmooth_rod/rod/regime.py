@@ -33,10 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import dumps_json, write_csv, write_json, write_text
-from .model.rod import RodProblem
-from .rod_hypotheses import RollingHypothesis, rolling_hypothesis
-from .validation import InputError
+from ..io import dumps_json, write_csv, write_json, write_text
+from .problem import RodProblem
+from .hypotheses import RollingHypothesis, rolling_hypothesis
+from ..validation import InputError
 
 SCENARIOS = ("slide-at-start", "roll-until-r1", "roll-until-r2", "roll-to-impact")
 CSV_COLUMNS = ("mu_s", "mu_d", "theta0_deg", "scenario", "t_transition", "t_impact", "phases")
@@ -73,7 +73,7 @@ def phases_text(phases) -> str:
 
 def scenario_of(phases, status: str = "ok") -> str:
     """The paper's scenario from ball A's phase sequence; the status word if the run failed."""
-    from .rod_simulation import scenario
+    from .simulation import scenario
 
     return status if status != "ok" else scenario(phases)
 
@@ -84,7 +84,7 @@ def classify_point(base: RodProblem, mu_s: float, mu_d: float, theta0_deg: float
 
     t_transition: when rolling ends (0 for slide-at-start; NaN if it never ends);
     t_impact: ball B's impact (NaN if none)."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     row = {"mu_s": float(mu_s), "mu_d": float(mu_d), "theta0_deg": float(theta0_deg)}
     try:

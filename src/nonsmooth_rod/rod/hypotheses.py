@@ -16,8 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
-from . import model  # noqa: F401  (package import order)
-from .model import rod_closed_form as cf
+from . import closed_form as cf
 
 
 @dataclass

@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from nonsmooth_rod.model import rod_closed_form as cf
+from nonsmooth_rod.rod import closed_form as cf
 from nonsmooth_rod.model.dynamics import mode_dynamics
-from nonsmooth_rod.model.rod import RodGeometry, RodProblem
+from nonsmooth_rod.rod.problem import RodGeometry, RodProblem
 from nonsmooth_rod.validation import InputError
 
 

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import pytest
 
-from nonsmooth_rod.integrators.switched import SwitchedOptions, SwitchedRod
-from nonsmooth_rod.model.rod import RodProblem
-from nonsmooth_rod.rod_simulation import simulate
+from nonsmooth_rod.rod.switched import SwitchedOptions, SwitchedRod
+from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.rod.simulation import simulate
 from nonsmooth_rod.validation import InputError
 
 # Event-driven reference (rtol 1e-12).

@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from .model import rod_closed_form as cf
-from .model.rod import PAPER_CASES, RodProblem
+from . import closed_form as cf
+from .problem import PAPER_CASES, RodProblem
 from .plotting import FORMATS, RunData, save_figure
-from .rod_hypotheses import RollingHypothesis, SlidingHypothesis, rolling_hypothesis, sliding_hypothesis
+from .hypotheses import RollingHypothesis, SlidingHypothesis, rolling_hypothesis, sliding_hypothesis
 
 CASE_COLOURS = ("tab:red", "tab:green", "tab:blue", "tab:purple", "tab:orange", "tab:brown")
 HYPOTHESIS_MU = (0.10, 0.257, 0.30)      # the paper's Figs. 22, 23, 24
@@ -176,7 +176,7 @@ def impact_detail_figure(mus=IMPACT_DETAIL_MU, base: RodProblem | None = None) -
 # --------------------------------------------------------------------------- the set
 def simulate_cases(base: RodProblem | None = None, cases=None) -> list[RunData]:
     """Event-driven runs of the friction cases (default: the paper's three) on base's body."""
-    from .rod_simulation import simulate
+    from .simulation import simulate
 
     base = base or RodProblem.paper()
     cases = cases or [PAPER_CASES[k] for k in sorted(PAPER_CASES)]

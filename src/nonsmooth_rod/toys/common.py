@@ -1,0 +1,109 @@
+"""What every toy shares: running one, building blocks, reading results, saving figures."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..integrators.event_driven import EventDriven, EventDrivenOptions
+from ..integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+from ..io import atomic_path
+from ..model.body import RigidBody, cross2, rotate
+from ..model.contacts import Line, PointOnLine
+from ..model.laws import ContactLaw
+from ..model.scene import Scene
+from ..results import SimulationResult
+from ..validation import InputError
+
+G = 9.81
+
+
+def run(toy, method: str = "moreau-jean", t_end: float = 1.0, *, h: float = 1e-3, theta: float = 0.5,
+        solver: str = "lemke", rtol: float = 1e-12, output_dt: float = 1e-3,
+        zeno_interval: float = 1e-9, fast: bool = True) -> SimulationResult:
+    """Run a toy from its initial state with Moreau–Jean ("moreau-jean", step h, θ, one-step
+    solver; `fast` allows its compiled loop where the scene permits) or the event-driven
+    reference ("event-driven", tolerance rtol, samples every output_dt)."""
+    scene = toy.scene()
+    q0, v0 = toy.initial_state()
+    if method == "moreau-jean":
+        integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, fast=fast))
+    elif method == "event-driven":
+        integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, output_dt=output_dt,
+                                                    zeno_interval=zeno_interval))
+    else:
+        raise InputError(f"unknown method '{method}'; choose moreau-jean or event-driven")
+    return integrator.run(scene, q0, v0, t_end)
+
+
+def _rectangle_inertia(mass: float, width: float, height: float) -> float:
+    return mass * (width**2 + height**2) / 12.0
+
+
+def _corners(body: int, width: float, height: float, line: Line, law: ContactLaw):
+    """The two bottom corners of a width × height rectangle, as point contacts on `line`."""
+    a, b = width / 2, height / 2
+    return [PointOnLine(body, (-a, -b), line, law, name="left"),
+            PointOnLine(body, (a, -b), line, law, name="right")]
+
+
+def _block_scene(toy, applied_force=None) -> Scene:
+    """A toy's width × height block on its `line`, both bottom corners with its μs/μd, e = 0."""
+    body = RigidBody(toy.mass, _rectangle_inertia(toy.mass, toy.width, toy.height), name="block")
+    law = ContactLaw.of(toy.mu_s, toy.mu_d, 0.0)
+    return Scene([body], _corners(0, toy.width, toy.height, toy.line, law), gravity=toy.g,
+                 applied_force=applied_force)
+
+
+def _force_along_floor(height: float, magnitude):
+    """Applied force `magnitude(t, q)` along +x acting at the block's bottom face (the floor
+    line), so it neither pitches the block nor unloads one corner."""
+    b = height / 2
+
+    def applied(t, q, v):
+        force = (magnitude(t, q), 0.0)
+        lever = rotate(q[2], (0.0, -b))  # from the centre of mass to the floor line
+        return np.array([force[0], force[1], cross2(lever, force)])
+
+    return applied
+
+
+def _slope_coordinate(result: SimulationResult, angle: float, body: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Position and velocity of a body's centre of mass along a line of inclination `angle`."""
+    t = (math.cos(angle), math.sin(angle))
+    q, v = result.trajectory.q, result.trajectory.v
+    i = 3 * body
+    s = q[:, i] * t[0] + q[:, i + 1] * t[1]
+    ds = v[:, i] * t[0] + v[:, i + 1] * t[1]
+    return s - s[0], ds
+
+
+def first_slip_time(result: SimulationResult, contacts=None) -> float | None:
+    """Start of the first phase in which any of `contacts` (default all) slips; None if never."""
+    names = contacts or result.contact_names
+    starts = [ph.t_start for name in names for ph in result.phases.get(name, [])
+              if ph.mode in ("slip+", "slip-")]
+    return min(starts) if starts else None
+
+
+
+
+def save_figure(fig, out_dir, name: str) -> "Path":
+    """Write a matplotlib figure to out_dir/name.png atomically and close it; returns the path."""
+    import matplotlib.pyplot as plt
+
+    path = Path(out_dir) / f"{name}.png"
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+    return path
+
+
+def example_parser(description: str):
+    """The command line every toy example shares: `--out DIR` for its figure."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--out", default=".", help="folder for the figure (default: current folder)")
+    return parser
