@@ -1,0 +1,226 @@
+"""Results of any scene as files and tables: trajectory.csv, summary.json, the scene file's copy.
+
+    save(result, "out/")        # trajectory.csv, summary.json (schema nonsmooth-rod/summary/2), scene copy
+    result = load("out/")       # the same SimulationResult back (floats bit for bit), scene_file attached
+    df = to_dataframe(result)   # pandas (optional extra): one tidy column per quantity
+    again = restart("out/", t=0.5, t_end=1.0)   # continue from the saved state at t
+
+Column names are `<body>.<quantity>` and `<contact>.<quantity>` (docs/output-format.md). A result
+made by `scenefile.simulate_scene` carries `result.scene_file`, which gives the names; otherwise
+bodies are body0, body1, ... and contacts keep the result's contact names.
+"""
+from __future__ import annotations
+
+import datetime
+import hashlib
+import platform
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .io import read_csv, write_csv, write_json, write_text
+from .results import Event, Impact, Phase, SimulationResult, Trajectory
+from .validation import InputError
+
+SUMMARY_SCHEMA = "nonsmooth-rod/summary/2"
+BODY_QUANTITIES = ("x", "y", "theta", "vx", "vy", "omega")  # m, m, rad, m/s, m/s, rad/s
+CONTACT_QUANTITIES = ("N", "T", "mode")  # N, N, word
+
+
+def body_names_of(result) -> list[str]:
+    sf = getattr(result, "scene_file", None)
+    if sf is not None:
+        return list(sf.body_names)
+    return [f"body{i}" for i in range(result.trajectory.q.shape[1] // 3)]
+
+
+def trajectory_columns(result) -> dict:
+    """Ordered columns of trajectory.csv: t, q and v of every body, N, T, mode of every contact."""
+    tr = result.trajectory
+    cols = {"t": np.asarray(tr.t, dtype=float)}
+    for i, name in enumerate(body_names_of(result)):
+        for j, qty in enumerate(BODY_QUANTITIES):
+            source = tr.q if j < 3 else tr.v
+            cols[f"{name}.{qty}"] = source[:, 3 * i + j % 3]
+    for k, name in enumerate(result.contact_names):
+        cols[f"{name}.N"] = tr.normal_force[:, k]
+        cols[f"{name}.T"] = tr.tangential_force[:, k]
+        cols[f"{name}.mode"] = [str(m) for m in tr.modes[:, k]]
+    return cols
+
+
+def provenance(command=None) -> dict:
+    def version(module):
+        try:
+            return __import__(module).__version__
+        except ImportError:
+            return None
+
+    return {"version": __version__, "command": command if command is not None else " ".join(sys.argv),
+            "python": platform.python_version(), "numpy": version("numpy"), "scipy": version("scipy"),
+            "numba": version("numba"), "created": datetime.datetime.now(datetime.timezone.utc).isoformat()}
+
+
+def _by_name(names, values) -> dict:
+    return {n: np.asarray(values, dtype=float)[3 * i:3 * i + 3].tolist() for i, n in enumerate(names)}
+
+
+def _impact_dict(imp: Impact, bodies, contacts) -> dict:
+    return {"t": float(imp.t), "contact": imp.contact, "q": _by_name(bodies, imp.q),
+            "v_before": _by_name(bodies, imp.v_before), "v_after": _by_name(bodies, imp.v_after),
+            "normal_impulse": dict(zip(contacts, np.asarray(imp.normal_impulse, float).tolist())),
+            "tangential_impulse": dict(zip(contacts, np.asarray(imp.tangential_impulse, float).tolist()))}
+
+
+def _scene_block(result) -> dict:
+    sf = getattr(result, "scene_file", None)
+    block = {"bodies": body_names_of(result), "contacts": list(result.contact_names)}
+    if sf is not None:
+        block.update(file=sf.source, title=sf.title, lines=sf.line_names, forces=sf.force_names,
+                     shapes=sf.shapes, overrides=list(sf.overrides),
+                     sha256=hashlib.sha256(sf.text.encode()).hexdigest() if sf.text else None)
+    return block
+
+
+def summary_dict(result, command=None) -> dict:
+    sf = getattr(result, "scene_file", None)
+    bodies, contacts = body_names_of(result), list(result.contact_names)
+    return {
+        "schema": SUMMARY_SCHEMA, "scene": _scene_block(result),
+        "params": sf.data if sf is not None else None,
+        "method": result.method,
+        "options": ({**sf.options, "t_end": sf.t_end, "stop": sf.stop} if sf is not None else {}),
+        "status": str(getattr(result.status, "value", result.status)), "message": result.message,
+        "success": bool(result.success),
+        "phases": {c: [ph.as_dict() for ph in result.phases.get(c, [])] for c in contacts},
+        "impacts": [_impact_dict(i, bodies, contacts) for i in result.impacts],
+        "events": [{"t": float(e.t), "kind": e.kind, "contact": e.contact, "detail": e.detail} for e in result.events],
+        "steps": int(getattr(result, "steps", 0)), "cpu_time_s": float(getattr(result, "cpu_time_s", 0.0)),
+        "stats": dict(result.stats), "provenance": provenance(command),
+    }
+
+
+def scene_copy_name(sf) -> str:
+    return "scene.json" if str(sf.source).lower().endswith(".json") else "scene.toml"
+
+
+def save(result, out_dir, command=None) -> dict:
+    """Write trajectory.csv, summary.json and (for a scene-file run) the scene file's copy; returns the summary."""
+    out_dir = Path(out_dir)
+    summary = summary_dict(result, command)
+    write_csv(out_dir / "trajectory.csv", trajectory_columns(result))
+    sf = getattr(result, "scene_file", None)
+    if sf is not None and sf.text:
+        write_text(out_dir / scene_copy_name(sf), sf.text)
+    write_json(out_dir / "summary.json", summary)
+    return summary
+
+
+def _read_summary(folder: Path) -> dict:
+    import json
+
+    path = folder / "summary.json"
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{folder}: no summary.json here (not a results folder of `nonsmooth-rod run`)") from None
+    except (OSError, ValueError) as err:
+        raise InputError(f"{path}: cannot read: {err}") from None
+    if summary.get("schema") != SUMMARY_SCHEMA:
+        raise InputError(f"{path}: schema must be {SUMMARY_SCHEMA!r}, got {summary.get('schema')!r}")
+    return summary
+
+
+def _trajectory_from(cols: dict, bodies, contacts) -> Trajectory:
+    def stack(quantities):
+        return np.column_stack([cols[f"{b}.{q}"] for b in bodies for q in quantities])
+
+    q, v = stack(BODY_QUANTITIES[:3]), stack(BODY_QUANTITIES[3:])
+    n = len(cols["t"])
+    forces = {qty: (np.column_stack([cols[f"{c}.{qty}"] for c in contacts]) if contacts else np.zeros((n, 0)))
+              for qty in ("N", "T")}
+    modes = (np.column_stack([np.asarray(cols[f"{c}.mode"], dtype=object) for c in contacts])
+             if contacts else np.zeros((n, 0), dtype=object))
+    return Trajectory(cols["t"], q, v, np.full_like(q, np.nan), forces["N"], forces["T"], modes)
+
+
+def _vector_of(by_name: dict, names) -> np.ndarray:
+    return np.concatenate([np.asarray(by_name[n], dtype=float) for n in names]) if names else np.zeros(0)
+
+
+def _impact_from(d: dict, bodies, contacts) -> Impact:
+    return Impact(d["t"], d["contact"], _vector_of(d["q"], bodies), _vector_of(d["v_before"], bodies),
+                  _vector_of(d["v_after"], bodies), np.array([d["normal_impulse"][c] for c in contacts]),
+                  np.array([d["tangential_impulse"][c] for c in contacts]))
+
+
+def load(folder):
+    """The SimulationResult saved in `folder` by save(); `scene_file` attached when the copy is there."""
+    from .scenefile import load_scene
+
+    folder = Path(folder)
+    summary = _read_summary(folder)
+    bodies, contacts = summary["scene"]["bodies"], summary["scene"]["contacts"]
+    try:
+        cols = read_csv(folder / "trajectory.csv")
+        trajectory = _trajectory_from(cols, bodies, contacts)
+    except (OSError, KeyError, ValueError, IndexError) as err:
+        raise InputError(f"{folder / 'trajectory.csv'}: cannot read the trajectory ({err})") from None
+    result = SimulationResult(
+        summary["method"], summary["status"], summary["message"], trajectory, list(contacts),
+        events=[Event(e["t"], e["kind"], e["contact"], e["detail"]) for e in summary["events"]],
+        impacts=[_impact_from(d, bodies, contacts) for d in summary["impacts"]],
+        phases={c: [Phase(p["mode"], p["t_start"], p["t_end"]) for p in summary["phases"][c]] for c in contacts},
+        steps=summary["steps"], cpu_time_s=summary["cpu_time_s"], stats=summary["stats"])
+    copies = [folder / n for n in ("scene.toml", "scene.json") if (folder / n).exists()]
+    result.scene_file = load_scene(copies[0], summary["scene"].get("overrides", ())) if copies else None
+    return result
+
+
+def to_dataframe(result):
+    """The trajectory as a pandas DataFrame, columns as in trajectory.csv (needs pandas)."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise InputError("to_dataframe needs pandas: pip install 'nonsmooth-rod[pandas]'") from None
+    return pd.DataFrame(trajectory_columns(result))
+
+
+def restart(source, t: float, t_end: float | None = None):
+    """Run on from the saved state at the last sample at or before `t` (a results folder or a
+    result with its scene_file), up to `t_end` (default: the scene file's t_end), same settings."""
+    from .scenefile import run_method
+
+    result = load(source) if isinstance(source, (str, Path)) else source
+    sf = getattr(result, "scene_file", None)
+    if sf is None:
+        raise InputError("restart needs the scene: a results folder with its scene copy, or a scene-file run")
+    times = np.asarray(result.trajectory.t)
+    k = int(np.searchsorted(times, t, side="right")) - 1
+    if k < 0:
+        raise InputError(f"restart time t = {t!r} precedes the saved run (starts at {times[0]:g} s)")
+    t0, t_end = float(times[k]), float(sf.t_end if t_end is None else t_end)
+    if t_end <= t0:
+        raise InputError(f"t_end = {t_end:g} s must exceed the restart time {t0:g} s")
+    q0, v0 = result.trajectory.q[k].copy(), result.trajectory.v[k].copy()
+    try:
+        again = run_method(sf.scene, q0, v0, t_end, sf.method, sf.options, sf.stop, t0=t0)
+    except InputError:
+        if sf.force_names:
+            raise
+        again = _shifted(run_method(sf.scene, q0, v0, t_end - t0, sf.method, sf.options, sf.stop), t0)
+    again.scene_file = sf
+    return again
+
+
+def _shifted(result, t0: float):
+    """A run of a time-invariant scene started at 0, moved to start at t0."""
+    result.trajectory.t = np.asarray(result.trajectory.t) + t0
+    for phases in result.phases.values():
+        for ph in phases:
+            ph.t_start, ph.t_end = ph.t_start + t0, ph.t_end + t0
+    for item in list(result.impacts) + list(result.events):
+        item.t = item.t + t0
+    return result

@@ -1,0 +1,550 @@
+"""Scene files: a whole simulation (bodies, lines, contacts, forces, initial state, method) as
+TOML or JSON, schema "nonsmooth-rod/scene/1" (docs/scene-format.md).
+
+    sf = load_scene("ball.toml", overrides=["contacts.floor.law.restitution=0.8"])
+    result = simulate_scene(sf)
+
+Every mistake is one InputError line naming the file, the key (a dotted path by name, the same
+syntax `--set` takes: `contacts.floor.law.mu_d`) and what is wrong.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .model.body import RigidBody
+from .model.contacts import DiskOnDisk, DiskOnLine, Line
+from .model.laws import ContactLaw
+from .scene_forces import FORCE_KINDS, build_force, make_scene
+from .validation import InputError
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10: the backport (dependency `tomli; python_version < "3.11"`)
+    import tomli as tomllib
+
+SCHEMA = "nonsmooth-rod/scene/1"
+METHODS = ("moreau-jean", "event-driven", "regularized")
+SHAPES = ("disk", "ball", "rectangle", "rod", "rod-with-balls")
+CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk")
+NAME_PATTERN = re.compile(r"^[A-Za-z0-9_+\-]+$")
+OVERLAP_TOLERANCE = 1e-9  # m per metre of the scene's size: penetration allowed in the initial state
+_REQUIRED = object()
+
+TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "contacts", "forces",
+            "initial", "simulation")
+BODY_KEYS = ("name", "mass", "inertia", "shape", "density", "thickness", "radius", "width", "height",
+             "length", "ball_radius", "rod_diameter")
+LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length")
+LAW_KEYS = ("mu_s", "mu_d", "restitution")
+CONTACT_KEYS = {
+    "disk-on-line": ("kind", "name", "body", "offset", "radius", "line", "law"),
+    "point-on-line": ("kind", "name", "body", "offset", "line", "law"),
+    "disk-on-disk": ("kind", "name", "body_a", "body_b", "radius_a", "radius_b", "offset_a", "offset_b", "law"),
+}
+FORCE_KEYS = {
+    "spring": ("kind", "name", "body", "point", "body_b", "point_b", "stiffness", "rest_length", "damping"),
+    "damper": ("kind", "name", "body", "point", "body_b", "point_b", "damping"),
+    "constant": ("kind", "name", "body", "force", "torque", "point"),
+    "ramped": ("kind", "name", "body", "force", "torque", "point", "t_start", "t_full"),
+    "tabulated": ("kind", "name", "body", "times", "forces", "torques", "point"),
+}
+
+
+@dataclass
+class SceneFile:
+    """A parsed scene file: the Scene, its initial state and how to run it, with every name."""
+
+    scene: object
+    q0: np.ndarray
+    v0: np.ndarray
+    t_end: float
+    method: str
+    options: dict
+    stop: list
+    body_names: list
+    contact_names: list
+    line_names: list
+    force_names: list
+    shapes: dict  # body name -> {"shape": ..., dimensions}; {} when drawn from its contacts
+    lines: dict  # line name -> Line
+    data: dict  # the file's content after overrides (JSON-able)
+    source: str = "<scene>"
+    title: str = ""
+    text: str = ""  # the file as read (for a copy next to the results)
+    overrides: list = field(default_factory=list)
+
+
+class _Where:
+    """Builds one-line errors: '<file>: <key>: <what>'."""
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def error(self, key: str, what: str) -> InputError:
+        return InputError(f"{self.source}: {key}: {what}" if key else f"{self.source}: {what}")
+
+
+# --- reading values ------------------------------------------------------------------------------
+
+def _check_keys(w: _Where, table, allowed, key: str) -> None:
+    if not isinstance(table, dict):
+        raise w.error(key, f"must be a table, got {table!r}")
+    unknown = [k for k in table if k not in allowed]
+    if unknown:
+        raise w.error(f"{key}.{unknown[0]}" if key else unknown[0],
+                      f"unknown key; allowed here: {', '.join(allowed)}")
+
+
+def _number(w: _Where, table: dict, name: str, key: str, default=_REQUIRED, *, positive=False,
+            nonnegative=False):
+    value = table.get(name, default)
+    full = f"{key}.{name}" if key else name
+    if value is _REQUIRED:
+        raise w.error(full, "missing (a number is required)")
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise w.error(full, f"must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise w.error(full, f"must be finite, got {value!r}")
+    if positive and value <= 0:
+        raise w.error(full, f"must be positive, got {value:g}")
+    if nonnegative and value < 0:
+        raise w.error(full, f"must be non-negative, got {value:g}")
+    return value
+
+
+def _vector(w: _Where, table: dict, name: str, key: str, n: int, default=_REQUIRED) -> tuple:
+    value = table.get(name, default)
+    full = f"{key}.{name}" if key else name
+    if value is _REQUIRED:
+        raise w.error(full, f"missing (a list of {n} numbers is required)")
+    if not isinstance(value, (list, tuple)) or len(value) != n:
+        raise w.error(full, f"must be a list of {n} numbers, got {value!r}")
+    return tuple(_number(w, {str(i): x for i, x in enumerate(value)}, str(i), full) for i in range(n))
+
+
+def _text(w: _Where, table: dict, name: str, key: str, default=_REQUIRED, choices=None) -> str:
+    value = table.get(name, default)
+    full = f"{key}.{name}" if key else name
+    if value is _REQUIRED:
+        raise w.error(full, "missing")
+    if not isinstance(value, str):
+        raise w.error(full, f"must be a string, got {value!r}")
+    if choices is not None and value not in choices:
+        raise w.error(full, f"must be one of {', '.join(choices)}; got {value!r}")
+    return value
+
+
+def _items(w: _Where, data: dict, section: str) -> list[tuple[str, dict]]:
+    """(name, table) of an array of tables, names checked: present, well-formed and unique."""
+    items = data.get(section, [])
+    if not isinstance(items, list):
+        raise w.error(section, f"must be an array of tables ([[{section}]]), got {items!r}")
+    out, seen = [], set()
+    for i, table in enumerate(items):
+        if not isinstance(table, dict):
+            raise w.error(f"{section}[{i}]", f"must be a table, got {table!r}")
+        name = table.get("name", _REQUIRED)
+        if name is _REQUIRED:
+            raise w.error(f"{section}[{i}].name", "missing (every entry needs a name)")
+        if not isinstance(name, str) or not NAME_PATTERN.match(name):
+            raise w.error(f"{section}[{i}].name", f"must be letters, digits, '_', '+' or '-', got {name!r}")
+        if name in seen:
+            raise w.error(f"{section}.{name}", "duplicate name")
+        seen.add(name)
+        out.append((name, table))
+    return out
+
+
+def _lookup(w: _Where, names: list, value, key: str, what: str) -> int:
+    if not isinstance(value, str):
+        raise w.error(key, f"must be the name of a {what}, got {value!r}")
+    if value not in names:
+        have = ", ".join(names) or "none"
+        raise w.error(key, f"no {what} named {value!r} (have: {have})")
+    return names.index(value)
+
+
+# --- bodies ----------------------------------------------------------------------------------------
+
+def _shape_mass(w, t, key, shape) -> float:
+    """Mass from density for the shapes that have a volume (kg/m³; disks and rectangles need a thickness)."""
+    rho = _number(w, t, "density", key, positive=True)
+    if shape == "ball":
+        return rho * 4.0 / 3.0 * math.pi * _number(w, t, "radius", key, positive=True) ** 3
+    if shape in ("disk", "rectangle"):
+        thick = _number(w, t, "thickness", key, positive=True)
+        if shape == "disk":
+            return rho * math.pi * _number(w, t, "radius", key, positive=True) ** 2 * thick
+        return rho * _number(w, t, "width", key, positive=True) * _number(w, t, "height", key, positive=True) * thick
+    raise w.error(f"{key}.density", f"a {shape} takes its mass directly: give mass instead")
+
+
+def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
+    """(drawing shape, mass, inertia) from `shape` and its dimensions; None where the shape gives none."""
+    shape = _text(w, t, "shape", key, None, SHAPES) if "shape" in t else None
+    if shape is None:
+        return {}, None, None
+    if shape == "rod-with-balls":
+        from .rod.problem import RodGeometry
+
+        dims = {k: _number(w, t, k, key, positive=True) for k in ("ball_radius", "rod_diameter", "length", "density")}
+        try:
+            mass, _, inertia = RodGeometry(**dims).inertial_properties()
+        except InputError as err:
+            raise w.error(key, str(err)) from None
+        return {"shape": shape, **{k: dims[k] for k in ("ball_radius", "rod_diameter", "length")}}, mass, inertia
+    needs = {"disk": ("radius",), "ball": ("radius",), "rectangle": ("width", "height"), "rod": ("length",)}[shape]
+    dims = {k: _number(w, t, k, key, positive=True) for k in needs}
+    if "mass" in t and "density" in t:
+        raise w.error(f"{key}.density", "give mass or density, not both")
+    mass = _number(w, t, "mass", key, positive=True) if "mass" in t else _shape_mass(w, t, key, shape)
+    factor = {"disk": dims.get("radius", 0) ** 2 / 2, "ball": 0.4 * dims.get("radius", 0) ** 2,
+              "rectangle": (dims.get("width", 0) ** 2 + dims.get("height", 0) ** 2) / 12,
+              "rod": dims.get("length", 0) ** 2 / 12}[shape]
+    return {"shape": shape, **dims}, mass, mass * factor
+
+
+def _bodies(w, data) -> tuple[list, list, dict]:
+    bodies, names, shapes = [], [], {}
+    for name, t in _items(w, data, "bodies"):
+        key = f"bodies.{name}"
+        _check_keys(w, t, BODY_KEYS, key)
+        shape, mass, inertia = _shape_of(w, t, key)
+        if "mass" in t or mass is None:
+            mass = _number(w, t, "mass", key, positive=True)
+        if "inertia" in t or inertia is None:
+            inertia = _number(w, t, "inertia", key, positive=True)
+        bodies.append(RigidBody(mass, inertia, name=name))
+        names.append(name)
+        shapes[name] = shape
+    if not bodies:
+        raise w.error("bodies", "a scene needs at least one [[bodies]] entry")
+    return bodies, names, shapes
+
+
+# --- lines, contacts, laws -------------------------------------------------------------------------
+
+def _lines(w, data) -> dict:
+    lines = {}
+    for name, t in _items(w, data, "lines"):
+        key = f"lines.{name}"
+        if "angle" in t:
+            raise w.error(f"{key}.angle", "angles of lines are given in degrees: write angle_deg")
+        _check_keys(w, t, LINE_KEYS, key)
+        _number(w, t, "length", key, None, positive=True)
+        lines[name] = Line(_vector(w, t, "point", key, 2, [0.0, 0.0]),
+                           math.radians(_number(w, t, "angle_deg", key, 0.0)),
+                           _number(w, t, "velocity", key, 0.0))
+    return lines
+
+
+def _law(w, t, key) -> ContactLaw:
+    law = t.get("law", {})
+    key = f"{key}.law"
+    _check_keys(w, law, LAW_KEYS, key)
+    mu_s = _number(w, law, "mu_s", key, 0.0, nonnegative=True)
+    mu_d = _number(w, law, "mu_d", key, mu_s, nonnegative=True)
+    e = _number(w, law, "restitution", key, 0.0)
+    if mu_d > mu_s:
+        raise w.error(f"{key}.mu_d", f"{mu_d:g} exceeds mu_s = {mu_s:g} (sliding friction cannot exceed static)")
+    if not 0.0 <= e <= 1.0:
+        raise w.error(f"{key}.restitution", f"must lie in [0, 1], got {e:g}")
+    return ContactLaw.of(mu_s, mu_d, e)
+
+
+def _contact(w, t, key, name, kind, body_names, lines):
+    law = _law(w, t, key)
+    if kind == "disk-on-disk":
+        a = _lookup(w, body_names, t.get("body_a"), f"{key}.body_a", "body")
+        b = _lookup(w, body_names, t.get("body_b"), f"{key}.body_b", "body")
+        if a == b:
+            raise w.error(f"{key}.body_b", "a disk-on-disk contact joins two different bodies")
+        return DiskOnDisk(a, b, _number(w, t, "radius_a", key, nonnegative=True),
+                          _number(w, t, "radius_b", key, nonnegative=True),
+                          _vector(w, t, "offset_a", key, 2, [0.0, 0.0]), _vector(w, t, "offset_b", key, 2, [0.0, 0.0]),
+                          law, name)
+    body = _lookup(w, body_names, t.get("body"), f"{key}.body", "body")
+    line = list(lines.values())[_lookup(w, list(lines), t.get("line"), f"{key}.line", "line")]
+    radius = _number(w, t, "radius", key, nonnegative=True) if kind == "disk-on-line" else 0.0
+    return DiskOnLine(body, _vector(w, t, "offset", key, 2, [0.0, 0.0]), line, radius, law, name)
+
+
+def _contacts(w, data, body_names, lines) -> list:
+    contacts = []
+    for name, t in _items(w, data, "contacts"):
+        key = f"contacts.{name}"
+        kind = _text(w, t, "kind", key, choices=CONTACT_KINDS)
+        _check_keys(w, t, CONTACT_KEYS[kind], key)
+        contacts.append(_contact(w, t, key, name, kind, body_names, lines))
+    return contacts
+
+
+# --- applied forces --------------------------------------------------------------------------------
+
+def _force_fields(w, t, key, kind, body_names) -> dict:
+    body = _lookup(w, body_names, t.get("body"), f"{key}.body", "body")
+    point = _vector(w, t, "point", key, 2, [0.0, 0.0])
+    if kind in ("spring", "damper"):
+        other = None if "body_b" not in t else _lookup(w, body_names, t["body_b"], f"{key}.body_b", "body")
+        fields = dict(body_a=body, point_a=point, body_b=other, point_b=_vector(w, t, "point_b", key, 2, [0.0, 0.0]),
+                      damping=_number(w, t, "damping", key, 0.0, nonnegative=True))
+        if kind == "spring":
+            fields.update(stiffness=_number(w, t, "stiffness", key, nonnegative=True),
+                          rest_length=_number(w, t, "rest_length", key, 0.0, nonnegative=True))
+        return fields
+    fields = dict(body=body, point=point)
+    if kind == "tabulated":
+        return {**fields, **_table_fields(w, t, key)}
+    fields.update(force=_vector(w, t, "force", key, 2, [0.0, 0.0]), torque=_number(w, t, "torque", key, 0.0))
+    if kind == "ramped":
+        fields.update(t_start=_number(w, t, "t_start", key, 0.0), t_full=_number(w, t, "t_full", key))
+        if fields["t_full"] <= fields["t_start"]:
+            raise w.error(f"{key}.t_full", f"must exceed t_start = {fields['t_start']:g}, got {fields['t_full']:g}")
+    return fields
+
+
+def _table_fields(w, t, key) -> dict:
+    times = t.get("times")
+    if not isinstance(times, list) or len(times) < 1:
+        raise w.error(f"{key}.times", f"must be a list of times, got {times!r}")
+    n = len(times)
+    times = _vector(w, t, "times", key, n)
+    if any(b <= a for a, b in zip(times, times[1:])):
+        raise w.error(f"{key}.times", "must increase strictly")
+    rows = t.get("forces")
+    if not isinstance(rows, list) or len(rows) != n:
+        raise w.error(f"{key}.forces", f"must be a list of {n} [fx, fy] pairs, one per time")
+    forces = tuple(_vector(w, {"forces": r}, "forces", f"{key}", 2) for r in rows)
+    torques = _vector(w, t, "torques", key, n) if "torques" in t else None
+    return dict(times=times, forces=forces, torques=torques)
+
+
+def _forces(w, data, body_names) -> list:
+    forces = []
+    for name, t in _items(w, data, "forces"):
+        key = f"forces.{name}"
+        kind = _text(w, t, "kind", key, choices=FORCE_KINDS)
+        _check_keys(w, t, FORCE_KEYS[kind], key)
+        try:
+            forces.append(build_force(kind, name=name, **_force_fields(w, t, key, kind, body_names)))
+        except InputError as err:
+            raise w.error(key, str(err)) from None
+    return forces
+
+
+# --- initial state, overlap -----------------------------------------------------------------------
+
+def _initial(w, data, body_names) -> tuple[np.ndarray, np.ndarray]:
+    init = data.get("initial", _REQUIRED)
+    if init is _REQUIRED:
+        raise w.error("initial", "missing: give [initial.<body>] q = [x, y, theta] for every body")
+    _check_keys(w, init, body_names, "initial")
+    q0, v0 = np.zeros(3 * len(body_names)), np.zeros(3 * len(body_names))
+    for i, name in enumerate(body_names):
+        key = f"initial.{name}"
+        if name not in init:
+            raise w.error(key, "missing: every body needs its initial q = [x, y, theta (rad)]")
+        _check_keys(w, init[name], ("q", "v"), key)
+        q0[3 * i:3 * i + 3] = _vector(w, init[name], "q", key, 3)
+        v0[3 * i:3 * i + 3] = _vector(w, init[name], "v", key, 3, [0.0, 0.0, 0.0])
+    return q0, v0
+
+
+def _scene_size(scene) -> float:
+    """A length for the overlap tolerance: the largest contact lever arm, at least 1 m."""
+    sizes = [1.0]
+    for c in scene.contacts:
+        for off, r in ((getattr(c, "offset", (0, 0)), getattr(c, "radius", 0.0)),
+                       (getattr(c, "offset_a", (0, 0)), getattr(c, "radius_a", 0.0)),
+                       (getattr(c, "offset_b", (0, 0)), getattr(c, "radius_b", 0.0))):
+            sizes.append(math.hypot(*off) + r)
+    return max(sizes)
+
+
+def _check_overlap(w, scene, q0, v0) -> None:
+    tol = OVERLAP_TOLERANCE * _scene_size(scene)
+    for c in scene.contacts:
+        try:
+            gap = c.kinematics(q0, v0, scene.n_dof).gap
+        except InputError as err:
+            raise w.error(f"contacts.{c.name}", f"at the initial state: {err}") from None
+        if gap < -tol:
+            raise w.error("initial", f"contact {c.name!r} starts overlapping by {-gap:.6g} m "
+                                     f"(tolerance {tol:.3g} m): move the bodies apart")
+
+
+# --- simulation settings ----------------------------------------------------------------------------
+
+def _options_class(method: str):
+    if method == "moreau-jean":
+        from .integrators.moreau_jean import MoreauJeanOptions as cls
+    elif method == "event-driven":
+        from .integrators.event_driven import EventDrivenOptions as cls
+    else:
+        from .integrators.regularized import RegularizedOptions as cls
+    return cls
+
+
+def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
+    sim = data.get("simulation", _REQUIRED)
+    if sim is _REQUIRED:
+        raise w.error("simulation", "missing: give [simulation] with at least t_end")
+    if not isinstance(sim, dict):
+        raise w.error("simulation", f"must be a table, got {sim!r}")
+    method = _text(w, sim, "method", "simulation", "moreau-jean", METHODS)
+    t_end = _number(w, sim, "t_end", "simulation", positive=True)
+    stop = sim.get("stop", [])
+    stop = [stop] if isinstance(stop, str) else stop
+    if not isinstance(stop, list):
+        raise w.error("simulation.stop", f"must be a contact name or a list of them, got {stop!r}")
+    for s in stop:
+        _lookup(w, contact_names, s, "simulation.stop", "contact")
+    cls = _options_class(method)
+    allowed = [f.name for f in dataclasses.fields(cls) if f.name not in ("stop_at_impact",)]
+    options = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop")}
+    _check_keys(w, options, allowed, "simulation")
+    _check_options(w, cls, options, stop)
+    return method, t_end, options, stop
+
+
+def _check_options(w, cls, options: dict, stop: list) -> None:
+    """Build the method's options once so a bad value is refused here, naming the key."""
+    for k, v in options.items():
+        if isinstance(v, float) and not math.isfinite(v):
+            raise w.error(f"simulation.{k}", f"must be finite, got {v!r}")
+    try:
+        cls(**options, stop_at_impact=stop[0] if stop else None)
+    except InputError as err:
+        raise w.error("simulation", str(err)) from None
+    except (TypeError, ValueError) as err:
+        raise w.error("simulation", f"bad option value: {err}") from None
+
+
+# --- overrides: --set contacts.floor.law.mu_s=0.3 ------------------------------------------------
+
+def _parse_value(text: str):
+    """A TOML value (number, bool, string, list); bare words are strings."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_override(data: dict, assignment: str, source: str = "--set") -> None:
+    """Set `path=value` in the file's data; arrays of tables are entered by name."""
+    if "=" not in assignment:
+        raise InputError(f"{source} {assignment!r}: expected PATH=VALUE, e.g. contacts.floor.law.mu_s=0.3")
+    path, text = assignment.split("=", 1)
+    keys = path.strip().split(".")
+    if not all(keys):
+        raise InputError(f"{source} {assignment!r}: empty key in the path {path!r}")
+    node, walked = data, []
+    for k in keys[:-1]:
+        walked.append(k)
+        if isinstance(node, list):
+            match = [t for t in node if isinstance(t, dict) and t.get("name") == k]
+            if not match:
+                have = ", ".join(str(t.get("name")) for t in node if isinstance(t, dict))
+                raise InputError(f"{source} {path}: no entry named {k!r} in {'.'.join(walked[:-1])} (have: {have})")
+            node = match[0]
+        elif isinstance(node, dict):
+            node = node.setdefault(k, {})
+        else:
+            raise InputError(f"{source} {path}: {'.'.join(walked[:-1])} is a value, not a table")
+    if not isinstance(node, dict):
+        raise InputError(f"{source} {path}: {'.'.join(keys[:-1])} is not a table")
+    node[keys[-1]] = _parse_value(text.strip())
+
+
+# --- reading a file ---------------------------------------------------------------------------------
+
+def read_data(path) -> tuple[dict, str]:
+    """The file's content as a dict (TOML, or JSON by the .json suffix) and its text."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise InputError(f"{path}: cannot read the scene file ({getattr(err, 'strerror', None) or err})") from None
+    try:
+        data = json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text)
+    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as err:
+        kind = "JSON" if path.suffix.lower() == ".json" else "TOML"
+        raise InputError(f"{path}: not valid {kind}: {err}") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: the scene must be a table/object at the top level")
+    return data, text
+
+
+def load_scene(path, overrides=()) -> SceneFile:
+    """Read, override and check a scene file (InputError naming file and key on any mistake)."""
+    data, text = read_data(path)
+    for assignment in overrides:
+        apply_override(data, assignment)
+    sf = parse_scene(data, source=str(path))
+    sf.text, sf.overrides = text, list(overrides)
+    return sf
+
+
+def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
+    """The SceneFile of a scene's content (a dict as read from TOML or JSON)."""
+    w = _Where(source)
+    _check_keys(w, data, TOP_KEYS, "")
+    schema = data.get("schema")
+    if schema != SCHEMA:
+        raise w.error("schema", f"must be {SCHEMA!r} (this version reads that schema), got {schema!r}")
+    gravity = _number(w, data, "gravity", "", 9.81, nonnegative=True)
+    bodies, body_names, shapes = _bodies(w, data)
+    lines = _lines(w, data)
+    contacts = _contacts(w, data, body_names, lines)
+    forces = _forces(w, data, body_names)
+    try:
+        scene = make_scene(bodies, contacts, gravity, forces)
+    except InputError as err:
+        raise w.error("", str(err)) from None
+    q0, v0 = _initial(w, data, body_names)
+    _check_overlap(w, scene, q0, v0)
+    contact_names = [c.name for c in contacts]
+    method, t_end, options, stop = _simulation(w, data, contact_names)
+    return SceneFile(scene, q0, v0, t_end, method, options, stop, body_names, contact_names, list(lines),
+                     [f.name for f in forces], shapes, lines, data, source,
+                     title=str(data.get("title", "")))
+
+
+# --- running ----------------------------------------------------------------------------------------
+
+def run_method(scene, q0, v0, t_end: float, method: str, options: dict, stop=(), t0: float = 0.0):
+    """The one place that calls an integrator: nr.simulate once the driver is in this branch."""
+    try:
+        from .driver import simulate
+    except ImportError:
+        simulate = None
+    if simulate is not None:
+        return simulate(scene, q0, v0, t_end, method, t0=t0, stop=list(stop) or None, **options)
+    if t0 != 0.0:
+        raise InputError("restarting at t0 > 0 needs nr.simulate (the driver), not yet in this build")
+    cls = _options_class(method)
+    opts = cls(**options, stop_at_impact=stop[0] if stop else None)
+    if method == "moreau-jean":
+        from .integrators.moreau_jean import MoreauJean as integrator
+    elif method == "event-driven":
+        from .integrators.event_driven import EventDriven as integrator
+    else:
+        from .integrators.regularized import Regularized as integrator
+    return integrator(opts).run(scene, np.asarray(q0, float), np.asarray(v0, float), t_end)
+
+
+def simulate_scene(sf: SceneFile):
+    """Run a loaded scene file with its own method, options and stop conditions."""
+    result = run_method(sf.scene, sf.q0, sf.v0, sf.t_end, sf.method, sf.options, sf.stop)
+    result.scene_file = sf  # names and shapes for files, figures and animations
+    return result
