@@ -15,7 +15,7 @@ from . import __version__
 from .validation import InputError
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT = 0, 1, 2
-STUDY_COMMANDS = ("plot", "sweep", "benchmark")
+STUDY_COMMANDS = ("plot", "sweep", "benchmark", "run", "animate")
 
 
 class _Parser(argparse.ArgumentParser):
