@@ -1,0 +1,198 @@
+"""Scene files: what they build (checked against the toys' own scenes and closed-form inertias),
+overrides by name, and one-line errors naming the file and the key for every malformed input."""
+import copy
+import json
+import math
+
+import numpy as np
+import pytest
+
+from nonsmooth_rod import toys
+from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.scene_forces import build_force
+from nonsmooth_rod.scenefile import apply_override, load_scene, parse_scene
+from nonsmooth_rod.validation import InputError
+
+from pathlib import Path
+
+SCENES = Path(__file__).resolve().parents[1] / "examples" / "scenes"
+
+BALL = {
+    "schema": "nonsmooth-rod/scene/1",
+    "bodies": [{"name": "ball", "shape": "ball", "radius": 0.05, "mass": 1.0}],
+    "lines": [{"name": "ground", "angle_deg": 0.0}],
+    "contacts": [{"kind": "disk-on-line", "name": "floor", "body": "ball", "radius": 0.05, "line": "ground",
+                  "law": {"mu_s": 0.3, "mu_d": 0.2, "restitution": 0.5}}],
+    "initial": {"ball": {"q": [0.0, 1.05, 0.0]}},
+    "simulation": {"t_end": 0.1, "h": 1e-3},
+}
+
+
+def _with(path: str, value):
+    data = copy.deepcopy(BALL)
+    apply_override(data, f"{path}={value}")
+    return data
+
+
+def test_ball_file_builds_the_toy_scene():
+    sf = load_scene(SCENES / "bouncing_ball.toml")
+    toy = toys.BouncingBall()
+    body, = sf.scene.bodies
+    assert body.mass == toy.mass and body.inertia == pytest.approx(0.4 * toy.mass * toy.radius**2, rel=1e-15)
+    q0, v0 = toy.initial_state()
+    np.testing.assert_array_equal(sf.q0, q0)
+    np.testing.assert_array_equal(sf.v0, v0)
+    c, = sf.scene.contacts
+    assert (c.radius, c.law.impact.restitution, c.line.angle) == (toy.radius, toy.restitution, 0.0)
+    assert sf.contact_names == ["floor"] and sf.body_names == ["ball"] and sf.method == "moreau-jean"
+
+
+def test_paper_rod_file_matches_rod_problem():
+    sf = load_scene(SCENES / "paper_rod.toml")
+    p = RodProblem.paper()
+    body, = sf.scene.bodies
+    assert body.mass == pytest.approx(p.mass, rel=1e-14) and body.inertia == pytest.approx(p.inertia, rel=1e-14)
+    q0, _ = p.initial_state()
+    np.testing.assert_allclose(sf.q0, q0, rtol=1e-15)
+    assert [c.offset for c in sf.scene.contacts] == [(-p.xi, 0.0), (p.length - p.xi, 0.0)]
+    assert sf.stop == ["B"]
+
+
+@pytest.mark.parametrize("shape, dims, inertia", [
+    ("disk", {"radius": 0.2}, 2.0 * 0.2**2 / 2),
+    ("ball", {"radius": 0.2}, 0.4 * 2.0 * 0.2**2),
+    ("rectangle", {"width": 0.3, "height": 0.1}, 2.0 * (0.09 + 0.01) / 12),
+    ("rod", {"length": 1.5}, 2.0 * 1.5**2 / 12),
+])
+def test_shapes_give_the_textbook_inertia(shape, dims, inertia):
+    data = copy.deepcopy(BALL)
+    data["bodies"][0] = {"name": "ball", "shape": shape, "mass": 2.0, **dims}
+    data["contacts"] = []
+    sf = parse_scene(data)
+    assert sf.scene.bodies[0].inertia == pytest.approx(inertia, rel=1e-15)
+    assert sf.shapes["ball"] == {"shape": shape, **dims}
+
+
+def test_density_gives_the_mass_of_a_steel_ball():
+    data = copy.deepcopy(BALL)
+    data["bodies"][0] = {"name": "ball", "shape": "ball", "radius": 0.02, "density": 7800.0}
+    assert parse_scene(data).scene.bodies[0].mass == pytest.approx(7800 * 4 / 3 * math.pi * 0.02**3, rel=1e-15)
+
+
+def test_json_and_toml_read_the_same(tmp_path):
+    sf = load_scene(SCENES / "ladder.toml")
+    path = tmp_path / "ladder.json"
+    path.write_text(json.dumps(sf.data))
+    again = load_scene(path)
+    np.testing.assert_array_equal(again.q0, sf.q0)
+    assert again.scene.contacts == sf.scene.contacts
+
+
+def test_overrides_reach_entries_by_name():
+    sf = load_scene(SCENES / "ladder.toml", ["contacts.foot.law.mu_s=0.2", "contacts.foot.law.mu_d=0.1",
+                                             "simulation.h=5e-4", "initial.ladder.v=[0.1, 0, 0]"])
+    foot = sf.scene.contacts[0]
+    assert (foot.law.friction.mu_s, foot.law.friction.mu_d) == (0.2, 0.1)
+    assert sf.options["h"] == 5e-4 and sf.v0[0] == 0.1
+    assert sf.data["contacts"][0]["law"]["mu_s"] == 0.2  # the summary records what ran
+
+
+def test_spring_force_pulls_towards_its_anchor_with_k_times_stretch():
+    spring = build_force("spring", body_a=0, point_a=(0.0, -0.1), point_b=(0.0, 0.0), stiffness=100.0,
+                         rest_length=0.0, damping=2.0, name="s")
+    q = np.array([0.3, 0.1, 0.0])  # the attachment point sits at (0.3, 0): stretched 0.3 m along x
+    v = np.array([0.5, 0.0, 0.0])
+    f = spring.generalised_force(0.0, q, v, 3)
+    tension = 100.0 * 0.3 + 2.0 * 0.5  # k stretch + c d(stretch)/dt
+    # force (-tension, 0) at the lever (0, -0.1): torque (0)(0) - (-0.1)(-tension) = -0.1 tension
+    np.testing.assert_allclose(f, [-tension, 0.0, -0.1 * tension], rtol=1e-15, atol=1e-15)
+
+
+def test_ramped_force_scales_linearly_between_its_times():
+    ramp = build_force("ramped", body=0, force=(10.0, 0.0), t_start=1.0, t_full=3.0, name="r")
+    assert [ramp.generalised_force(t, np.zeros(3), np.zeros(3), 3)[0] for t in (0.0, 2.0, 5.0)] == [0.0, 5.0, 10.0]
+
+
+BAD = [
+    ("bodies.ball.mass", "-1", "bodies.ball.mass: must be positive"),
+    ("bodies.ball.mass", "nan", "bodies.ball.mass: must be finite"),
+    ("bodies.ball.mass", '"heavy"', "bodies.ball.mass: must be a number"),
+    ("bodies.ball.colour", '"red"', "bodies.ball.colour: unknown key"),
+    ("bodies.ball.shape", '"cube"', "bodies.ball.shape: must be one of"),
+    ("contacts.floor.body", '"bal"', "contacts.floor.body: no body named 'bal' (have: ball)"),
+    ("contacts.floor.line", '"wall"', "contacts.floor.line: no line named 'wall'"),
+    ("contacts.floor.kind", '"disk-on-cube"', "contacts.floor.kind: must be one of"),
+    ("contacts.floor.law.mu_d", "0.5", "contacts.floor.law.mu_d: 0.5 exceeds mu_s = 0.3"),
+    ("contacts.floor.law.restitution", "1.5", "contacts.floor.law.restitution: must lie in [0, 1]"),
+    ("contacts.floor.law.mu", "0.5", "contacts.floor.law.mu: unknown key"),
+    ("contacts.floor.offset", "[0, 0, 0]", "contacts.floor.offset: must be a list of 2 numbers"),
+    ("lines.ground.angle", "30", "lines.ground.angle: angles of lines are given in degrees"),
+    ("initial.ball.q", "[0, 0.01, 0]", "contact 'floor' starts overlapping by 0.04 m"),
+    ("initial.ball.q", "[0, 1]", "initial.ball.q: must be a list of 3 numbers"),
+    ("initial.box.q", "[0, 1, 0]", "initial.box: unknown key"),
+    ("simulation.method", '"rk4"', "simulation.method: must be one of moreau-jean"),
+    ("simulation.t_end", "0", "simulation.t_end: must be positive"),
+    ("simulation.h", "-1e-3", "simulation: h (step size) must be positive"),
+    ("simulation.rtol", "1e-6", "simulation.rtol: unknown key"),
+    ("simulation.solver", '"magic"', "simulation: unknown solver 'magic'"),
+    ("simulation.stop", '"flor"', "simulation.stop: no contact named 'flor'"),
+    ("schema", '"nonsmooth-rod/scene/9"', "schema: must be 'nonsmooth-rod/scene/1'"),
+    ("gravity", "inf", "gravity: must be finite"),
+]
+
+
+@pytest.mark.parametrize("path, value, message", BAD, ids=[f"{p}={v}" for p, v, _ in BAD])
+def test_bad_values_are_one_line_naming_file_and_key(path, value, message):
+    with pytest.raises(InputError) as err:
+        parse_scene(_with(path, value), source="my.toml")
+    text = str(err.value)
+    assert text.startswith("my.toml: ") and message in text and "\n" not in text
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d["bodies"].append({"name": "ball", "mass": 1, "inertia": 1}), "bodies.ball: duplicate name"),
+    (lambda d: d["bodies"][0].pop("name"), "bodies[0].name: missing"),
+    (lambda d: d["bodies"][0].update(name="a.b"), "bodies[0].name: must be letters"),
+    (lambda d: d.pop("initial"), "initial: missing"),
+    (lambda d: d.pop("simulation"), "simulation: missing"),
+    (lambda d: d["initial"].pop("ball"), "initial.ball: missing"),
+    (lambda d: d.update(bodies=[]), "bodies: a scene needs at least one"),
+    (lambda d: d.update(extra=1), "extra: unknown key"),
+    (lambda d: d["contacts"].append({"kind": "disk-on-disk", "name": "dd", "body_a": "ball", "body_b": "ball",
+                                     "radius_a": 0.1, "radius_b": 0.1}), "contacts.dd.body_b: a disk-on-disk"),
+    (lambda d: d.update(forces=[{"kind": "ramped", "name": "p", "body": "ball", "force": [1, 0],
+                                 "t_start": 1.0, "t_full": 1.0}]), "forces.p.t_full: must exceed t_start"),
+    (lambda d: d.update(forces=[{"kind": "tabulated", "name": "tab", "body": "ball", "times": [0, 1],
+                                 "forces": [[1, 0]]}]), "forces.tab.forces: must be a list of 2"),
+    (lambda d: d.update(forces=[{"kind": "spring", "name": "s", "body": "ghost", "stiffness": 1}]),
+     "forces.s.body: no body named 'ghost'"),
+])
+def test_bad_structure_is_one_line(edit, message):
+    data = copy.deepcopy(BALL)
+    edit(data)
+    with pytest.raises(InputError) as err:
+        parse_scene(data, source="my.toml")
+    assert message in str(err.value) and "\n" not in str(err.value) and str(err.value).startswith("my.toml")
+
+
+def test_unreadable_and_malformed_files(tmp_path):
+    with pytest.raises(InputError, match="cannot read the scene file"):
+        load_scene(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("schema = \n")
+    with pytest.raises(InputError, match=r"bad\.toml: not valid TOML: .*line 1"):
+        load_scene(bad)
+    bad_json = tmp_path / "bad.json"
+    bad_json.write_text("{")
+    with pytest.raises(InputError, match="not valid JSON"):
+        load_scene(bad_json)
+
+
+@pytest.mark.parametrize("assignment, message", [
+    ("contacts.flor.law.mu_s=0.3", "no entry named 'flor'"),
+    ("contacts.floor.law.mu_s", "expected PATH=VALUE"),
+    ("contacts..mu_s=1", "empty key"),
+])
+def test_bad_overrides(assignment, message):
+    with pytest.raises(InputError, match=message):
+        apply_override(copy.deepcopy(BALL), assignment)
