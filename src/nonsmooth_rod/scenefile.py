@@ -414,7 +414,21 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
     options = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop")}
     _check_keys(w, options, allowed, "simulation")
     _check_options(w, cls, options, stop)
+    _check_output_size(w, method, t_end, options, cls)
     return method, t_end, options, stop
+
+
+MAX_SAMPLES = 50_000_000  # ~ 2 GB for a one-body, two-contact scene: beyond it the run cannot be held
+
+
+def _check_output_size(w, method, t_end, options, cls) -> None:
+    """Refuse up front a run whose samples cannot fit in memory (naming the option that fixes it)."""
+    key = "h" if method == "moreau-jean" else "output_dt"
+    spacing = options.get(key, getattr(cls(), key))
+    samples = t_end / spacing
+    if samples > MAX_SAMPLES:
+        raise w.error(f"simulation.{key}", f"t_end / {key} = {samples:.3g} samples exceed {MAX_SAMPLES:.0e}: "
+                                           f"raise {key} or shorten t_end")
 
 
 def _check_options(w, cls, options: dict, stop: list) -> None:
