@@ -177,8 +177,9 @@ def test_save_load_round_trip_and_restart(tmp_path):
     (["run", str(SCENES / "ladder.toml"), "--set", "contacts.knee.law.mu_s=1"], "no entry named 'knee'"),
     (["run", str(SCENES / "ladder.toml"), "--set", "simulation.h=nan"], "simulation"),
     (["animate", "nowhere"], "no summary.json"),
+    (["run", str(SCENES / "ladder.toml"), "--out", __file__], "--out"),
 ])
 def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, fragment):
-    assert main(args + (["--out", str(tmp_path)] if args[0] == "run" else [])) == 2
+    assert main(args + (["--out", str(tmp_path)] if args[0] == "run" and "--out" not in args else [])) == 2
     captured = capsys.readouterr()
     assert fragment in captured.err and captured.err.count("\n") == 1 and "Traceback" not in captured.err

@@ -30,7 +30,9 @@ def cmd_animate(args) -> int:
     result = load(args.folder)
     if result.scene_file is None:
         raise InputError(f"{args.folder}: no scene copy (scene.toml/scene.json) to draw the bodies from")
-    out = Path(args.out) if args.out else Path(args.folder)
+    from .run import writable_folder
+
+    out = writable_folder(args.out) if args.out else Path(args.folder)
     for note in write_animation(result, out, frames=args.frames, fps=args.fps):
         if not args.quiet:
             print(note)

@@ -7,6 +7,7 @@ and figure.png into --out; prints a phase table per contact and the impacts. Exi
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -30,6 +31,20 @@ def register(subparsers) -> None:
     p.add_argument("--animate", action="store_true", help="also write animation.gif (and animation.mp4 with ffmpeg)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=cmd_run)
+
+
+def writable_folder(text: str) -> Path:
+    """--out as a folder that exists (made if needed) and takes files, else a one-line InputError."""
+    from ..validation import InputError
+
+    out_dir = Path(text)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise InputError(f"--out {text}: cannot make the folder ({err.strerror or err})") from None
+    if not os.access(out_dir, os.W_OK | os.X_OK):
+        raise InputError(f"--out {text}: the folder is not writable")
+    return out_dir
 
 
 def _fmt(x: float) -> str:
@@ -75,8 +90,8 @@ def cmd_run(args) -> int:
     from ..scenefile import load_scene, simulate_scene
 
     scene_file = load_scene(args.scene, args.set)
+    out_dir = writable_folder(args.out)
     result = simulate_scene(scene_file)
-    out_dir = Path(args.out)
     command = "nonsmooth-rod " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["run"] else None
     summary = save(result, out_dir, command=command)
     console = Console(soft_wrap=True, stderr=False)

@@ -44,22 +44,25 @@ def _paths(ax, result, names) -> None:
         ax.plot(q[0, 3 * i], q[0, 3 * i + 1], "o", color=ax.lines[-1].get_color(), ms=4)
     sf = getattr(result, "scene_file", None)
     if sf is not None:
-        from .animation import draw_lines
-        draw_lines(ax, sf, ax.dataLim)
+        from .animation import draw_lines, scene_extent
+
+        extent = scene_extent(result, sf)
+        draw_lines(ax, sf, extent)
+        ax.set(xlim=extent[:2], ylim=extent[2:])
     ax.set(xlabel="x [m]", ylabel="y [m]", title="paths of the centres of mass (o: start)")
-    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_aspect("equal", adjustable="box")
     ax.legend(fontsize="small")
 
 
 def _coordinates(ax, result, names) -> None:
     t, q = result.trajectory.t, result.trajectory.q
-    for i, name in enumerate(names):
-        ax.plot(t, q[:, 3 * i], label=f"{name} x")
-        ax.plot(t, q[:, 3 * i + 1], "--", label=f"{name} y")
-    ax.set(xlabel="t [s]", ylabel="[m]", title="centre-of-mass coordinates")
     right = ax.twinx()
     for i, name in enumerate(names):
-        right.plot(t, q[:, 3 * i + 2], ":", label=f"{name} θ")
+        colour = f"C{i % 10}"
+        ax.plot(t, q[:, 3 * i], color=colour, label=f"{name} x")
+        ax.plot(t, q[:, 3 * i + 1], "--", color=colour, label=f"{name} y")
+        right.plot(t, q[:, 3 * i + 2], ":", color=colour, label=f"{name} θ")
+    ax.set(xlabel="t [s]", ylabel="x (solid), y (dashed) [m]", title="centre-of-mass coordinates")
     right.set_ylabel("θ [rad] (dotted)")
     ax.legend(fontsize="x-small", loc="best")
 
