@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..cli import _int
+from .options import integer as _int
 from ..validation import InputError
 
 DESCRIPTION = """\

@@ -105,5 +105,6 @@ def example_parser(description: str):
     import argparse
 
     parser = argparse.ArgumentParser(description=description)
-    parser.add_argument("--out", default=".", help="folder for the figure (default: current folder)")
+    parser.add_argument("--out", default="results/examples",
+                        help="folder for the figure (default: ./results/examples)")
     return parser
