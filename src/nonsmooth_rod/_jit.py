@@ -66,3 +66,56 @@ def jit(function):
 
 
 __all__ = ["jit", "ENABLED"]
+
+
+# ---------------------------------------------------------------- saying when we compile
+# The first compiled run on a fresh install compiles the engine (seconds); later processes load
+# it from the cache. A marker next to the cache records that compiling has happened for this
+# version, so the CLI can say "compiling the engine, once" only when it really will.
+COMPILE_ESTIMATE_S = 10  # measured by benchmarks/bench_startup.py on the 2-core reference machine
+_notifier = None
+
+
+def _marker() -> Path:
+    from . import __version__
+
+    base = os.environ.get("NUMBA_CACHE_DIR") or str(Path(__file__).resolve().parent / "__pycache__")
+    return Path(base) / f"nonsmooth-rod-{__version__}.compiled"
+
+
+def engine_is_warm() -> bool:
+    """True when the engine's compiled kernels are (very likely) in the on-disk cache."""
+    return not ENABLED or _marker().exists()
+
+
+def set_compile_notifier(notify) -> None:
+    """`notify(message)` is called once, before a compile that will take a while (the CLI prints it)."""
+    global _notifier
+    _notifier = notify
+
+
+class compiling_notice:
+    """Context manager around a compiled run: says once that compiling happens, marks it done."""
+
+    def __init__(self, active: bool = True):
+        self.active = active
+
+    def __enter__(self):
+        self.cold = self.active and not engine_is_warm()
+        if self.cold:
+            import logging
+
+            message = f"compiling the engine, once: ~{COMPILE_ESTIMATE_S} s"
+            logging.getLogger("nonsmooth_rod").info(message)
+            if _notifier is not None:
+                _notifier(message)
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if self.cold and exc_type is None:
+            try:
+                _marker().parent.mkdir(parents=True, exist_ok=True)
+                _marker().touch()
+            except OSError:
+                pass
+        return False

@@ -33,6 +33,13 @@ def make_parser() -> Parser:
     return parser
 
 
+def _say_when_compiling() -> None:
+    """A first compiled run takes seconds: say so on stderr (stdout may carry JSON)."""
+    from . import _jit
+
+    _jit.set_compile_notifier(lambda message: print(f"nonsmooth-rod: {message}", file=sys.stderr, flush=True))
+
+
 def main(argv=None) -> int:
     parser = make_parser()
     try:
@@ -40,6 +47,8 @@ def main(argv=None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_BAD_INPUT
+        if not getattr(args, "quiet", False):
+            _say_when_compiling()
         return args.handler(args)
     except InputError as err:
         print(f"nonsmooth-rod: error: {err}", file=sys.stderr)
