@@ -121,3 +121,16 @@ def escape(text: str) -> str:
     from rich.markup import escape as rich_escape
 
     return rich_escape(text)
+
+
+def image_formats(text: str) -> tuple[str, ...]:
+    """Comma-separated image formats (argparse type): known ones, each once."""
+    from ..rod.plotting import FORMATS
+
+    fmts = [f.strip().lower() for f in text.split(",") if f.strip()]
+    bad = [f for f in fmts if f not in FORMATS]
+    if not fmts or bad:
+        raise argparse.ArgumentTypeError(f"formats must be among {', '.join(FORMATS)}, got {text!r}")
+    if len(set(fmts)) != len(fmts):
+        raise argparse.ArgumentTypeError(f"each format once, got {text!r}")
+    return tuple(fmts)
