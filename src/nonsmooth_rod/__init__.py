@@ -1,2 +1,28 @@
-"""nonsmooth-rod: nonsmooth contact dynamics with two-coefficient Coulomb friction."""
-__version__ = "0.1.0"
+"""nonsmooth-rod: nonsmooth contact dynamics of planar rigid bodies with two-coefficient Coulomb
+friction — Moreau–Jean time-stepping checked against an event-driven reference.
+
+    import nonsmooth_rod as nr
+    scene = nr.Scene([nr.RigidBody(1.0, 0.01)], [nr.DiskOnLine(0, (0.0, 0.0), nr.Line(), 0.05,
+                     nr.ContactLaw.of(mu_s=0.3, mu_d=0.2))])
+    result = nr.simulate(scene, q0, v0, t_end=1.0, method="moreau-jean", h=1e-3)
+
+The engine (model, solvers, integrators, results) is at the root; the paper's rod
+(`nonsmooth_rod.rod`) and the contact toys (`nonsmooth_rod.toys`) are applications of it.
+"""
+__version__ = "0.2.0"
+
+from .driver import StopAtImpact, simulate
+from .model.body import RigidBody
+from .model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLine
+from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
+from .model.scene import Scene
+from .results import ContactState, Event, Impact, Phase, SimulationResult, Status, Trajectory
+from .solvers import ContactSolution, PlanarFrictionProblem, SolverError, solve
+from .validation import InputError
+
+__all__ = [
+    "__version__", "simulate", "StopAtImpact", "Scene", "RigidBody", "Line", "DiskOnLine", "PointOnLine",
+    "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
+    "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
+    "ContactSolution", "SolverError", "InputError",
+]

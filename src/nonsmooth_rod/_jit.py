@@ -2,10 +2,40 @@
 
 The same source runs both ways, so there is never a second copy of a kernel to keep in step.
 `NONSMOOTH_ROD_NO_JIT=1` forces the interpreted path (tests use it to compare the two).
+
+Compiled kernels are cached on disk (numba's `cache=True`), next to the package by default.
+Where that folder is read-only (a system install, a container image) the cache goes to a
+user folder instead — `$XDG_CACHE_HOME/nonsmooth-rod/numba` or `~/.cache/nonsmooth-rod/numba` —
+unless `NUMBA_CACHE_DIR` is set, which always wins.
 """
 from __future__ import annotations
 
 import os
+import warnings
+from pathlib import Path
+
+
+def _user_cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "nonsmooth-rod" / "numba"
+
+
+def _choose_cache_dir() -> None:
+    """Point numba at a writable cache when the package folder is not (before numba is imported)."""
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    here = Path(__file__).resolve().parent
+    if os.access(here, os.W_OK):
+        return
+    target = _user_cache_dir()
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return  # numba then compiles in memory each run; still correct
+    os.environ["NUMBA_CACHE_DIR"] = str(target)
+
+
+_choose_cache_dir()
 
 try:  # numba is the optional `fast` extra
     import numba as _numba
@@ -13,6 +43,15 @@ except ImportError:  # pragma: no cover - exercised on installs without numba
     _numba = None
 
 ENABLED = _numba is not None and os.environ.get("NONSMOOTH_ROD_NO_JIT", "") in ("", "0")
+_warned = False
+
+
+def _warn_once() -> None:
+    global _warned
+    if _numba is None and not _warned:
+        _warned = True
+        warnings.warn("numba is not installed: the compiled Moreau–Jean engine is off and runs are about "
+                      "30x slower (pip install 'nonsmooth-rod[fast]')", RuntimeWarning, stacklevel=3)
 
 
 def jit(function):
@@ -21,8 +60,62 @@ def jit(function):
     Kernels take float64 arrays and int64 indices only, so each compiles to one signature.
     """
     if not ENABLED:
+        _warn_once()
         return function
     return _numba.njit(cache=True)(function)
 
 
 __all__ = ["jit", "ENABLED"]
+
+
+# ---------------------------------------------------------------- saying when we compile
+# The first compiled run on a fresh install compiles the engine (seconds); later processes load
+# it from the cache. A marker next to the cache records that compiling has happened for this
+# version, so the CLI can say "compiling the engine, once" only when it really will.
+COMPILE_ESTIMATE_S = 10  # measured by benchmarks/bench_startup.py on the 2-core reference machine
+_notifier = None
+
+
+def _marker() -> Path:
+    from . import __version__
+
+    base = os.environ.get("NUMBA_CACHE_DIR") or str(Path(__file__).resolve().parent / "__pycache__")
+    return Path(base) / f"nonsmooth-rod-{__version__}.compiled"
+
+
+def engine_is_warm() -> bool:
+    """True when the engine's compiled kernels are (very likely) in the on-disk cache."""
+    return not ENABLED or _marker().exists()
+
+
+def set_compile_notifier(notify) -> None:
+    """`notify(message)` is called once, before a compile that will take a while (the CLI prints it)."""
+    global _notifier
+    _notifier = notify
+
+
+class compiling_notice:
+    """Context manager around a compiled run: says once that compiling happens, marks it done."""
+
+    def __init__(self, active: bool = True):
+        self.active = active
+
+    def __enter__(self):
+        self.cold = self.active and not engine_is_warm()
+        if self.cold:
+            import logging
+
+            message = f"compiling the engine, once: ~{COMPILE_ESTIMATE_S} s"
+            logging.getLogger("nonsmooth_rod").info(message)
+            if _notifier is not None:
+                _notifier(message)
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if self.cold and exc_type is None:
+            try:
+                _marker().parent.mkdir(parents=True, exist_ok=True)
+                _marker().touch()
+            except OSError:
+                pass
+        return False

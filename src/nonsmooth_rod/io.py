@@ -68,14 +68,15 @@ def write_json(path, data) -> None:
 
 
 def write_csv(path, columns: dict, order=None) -> None:
-    """Columns of equal length; floats with 17 significant digits (round-trip exact)."""
+    """Columns of equal length; floats in their shortest round-trip form (0.05, not
+    0.050000000000000003): reading the file back gives the very same float64."""
     order = list(order or columns.keys())
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(order)
     cols = [columns[name] for name in order]
     for row in zip(*cols):
-        writer.writerow([f"{x:.17g}" if isinstance(x, (float, np.floating)) else x for x in row])
+        writer.writerow([repr(float(x)) if isinstance(x, (float, np.floating)) else x for x in row])
     write_text(path, buf.getvalue())
 
 
@@ -92,3 +93,27 @@ def read_csv(path) -> dict:
         except ValueError:
             out[name] = np.array(col, dtype=object)
     return out
+
+
+def provenance(command: str | None = None) -> dict:
+    """Where a result came from: package and library versions, the command line, the time."""
+    import datetime
+    import platform
+    import shlex
+    import sys
+    from importlib import metadata
+
+    from . import __version__
+
+    def version(name: str):
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            return None
+
+    if command is None:
+        command = " ".join(shlex.quote(a) for a in ["nonsmooth-rod", *sys.argv[1:]]) \
+            if sys.argv and sys.argv[0].endswith("nonsmooth-rod") else " ".join(map(shlex.quote, sys.argv))
+    return {"version": __version__, "command": command, "python": platform.python_version(),
+            "numpy": np.__version__, "scipy": version("scipy"), "numba": version("numba"),
+            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}

@@ -6,12 +6,63 @@ human `message`, whatever integrator produced it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import Enum
 
 import numpy as np
 
+
+class ContactState(str, Enum):
+    """What one contact does over a step or phase. A str-Enum: compares equal to its word."""
+
+    OPEN = "open"
+    STICK = "stick"
+    SLIP_POS = "slip+"  # slip velocity > 0 along the contact tangent
+    SLIP_NEG = "slip-"
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __repr__(self) -> str:  # prints like the word it stands for, e.g. in f"{status!r}"
+        return repr(self.value)
+
+    @property
+    def code(self) -> int:
+        """The small integer compiled code stores (0 open, 1 stick, 2 slip+, 3 slip−)."""
+        return CONTACT_STATES.index(self.value)
+
+
+class Status(str, Enum):
+    """How a run ended. A str-Enum: `result.status == "ok"` keeps working."""
+
+    OK = "ok"  # reached t_end
+    STOPPED = "stopped"  # a stop condition ended the run
+    NO_IMPACT = "no-impact"  # the awaited impact did not happen in time
+    PAINLEVE = "painleve"  # the sliding problem has no or several solutions
+    ZENO = "zeno"  # accumulation of impacts
+    LIFTOFF = "liftoff"
+    TOO_MANY_EVENTS = "too-many-events"
+    TOO_MANY_STEPS = "too-many-steps"
+    TIME_LIMIT = "time-limit"
+    STEP_SIZE_COLLAPSE = "step-size-collapse"  # an adaptive ODE solver's step fell to round-off
+    PENETRATION = "penetration"  # a penalty contact sank deeper than its model allows
+    NON_FINITE = "nan"  # the state became NaN or infinite inside an ODE solver
+    FAILED = "failed"  # a one-step solver failed or the state became non-finite
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __repr__(self) -> str:  # prints like the word it stands for, e.g. in f"{status!r}"
+        return repr(self.value)
+
+    @property
+    def success(self) -> bool:
+        return self in (Status.OK, Status.STOPPED)
+
+
+# The contact-state words in code order; the rod's tables say "flight" for "open".
+CONTACT_STATES = tuple(s.value for s in ContactState)
 MODES = ("stick", "slip+", "slip-", "flight")
-# Contact-state words used per contact by every integrator ("open" = no contact).
-CONTACT_STATES = ("open", "stick", "slip+", "slip-")
+SLIP_STATES = (ContactState.SLIP_POS.value, ContactState.SLIP_NEG.value)
 
 
 @dataclass
@@ -21,6 +72,11 @@ class Phase:
     mode: str
     t_start: float
     t_end: float
+
+    def __post_init__(self):
+        self.mode = str(self.mode)
+        self.t_start = float(self.t_start)
+        self.t_end = float(self.t_end)
 
     @property
     def duration(self) -> float:
@@ -39,6 +95,9 @@ class Event:
     contact: str = ""
     detail: dict = field(default_factory=dict)
 
+    def __post_init__(self):
+        self.t = float(self.t)
+
 
 @dataclass
 class Impact:
@@ -51,6 +110,9 @@ class Impact:
     v_after: np.ndarray
     normal_impulse: np.ndarray
     tangential_impulse: np.ndarray
+
+    def __post_init__(self):
+        self.t = float(self.t)
 
 
 @dataclass
@@ -72,8 +134,16 @@ class Trajectory:
 
 @dataclass
 class SimulationResult:
+    """One run of any integrator, shaped after scipy's OdeResult.
+
+    `status` (a `Status`) and `message` say how it ended; `t`, `q`, `v`, `normal_force`,
+    `tangential_force` and `modes` are the saved samples (also in `trajectory`); `phases` maps
+    each contact name to its maximal constant-state intervals; `impacts` and `events` are
+    located in time; `stats` counts the work (steps, solves, whether the loop was compiled).
+    """
+
     method: str
-    status: str  # "ok", "painleve", "zeno", "liftoff", "failed", ...
+    status: Status
     message: str
     trajectory: Trajectory
     contact_names: list[str]
@@ -84,13 +154,40 @@ class SimulationResult:
     cpu_time_s: float = 0.0
     stats: dict = field(default_factory=dict)
 
+    def __post_init__(self):
+        self.status = Status(self.status)
+
     @property
     def success(self) -> bool:
-        return self.status == "ok"
+        return self.status.success
 
     @property
     def t(self) -> np.ndarray:
         return self.trajectory.t
+
+    @property
+    def q(self) -> np.ndarray:
+        return self.trajectory.q
+
+    @property
+    def v(self) -> np.ndarray:
+        return self.trajectory.v
+
+    @property
+    def normal_force(self) -> np.ndarray:
+        return self.trajectory.normal_force
+
+    @property
+    def tangential_force(self) -> np.ndarray:
+        return self.trajectory.tangential_force
+
+    @property
+    def modes(self) -> np.ndarray:
+        return self.trajectory.modes
+
+    def set_status(self, status, message: str) -> None:
+        self.status = Status(status)
+        self.message = message
 
 
 def phases_from_intervals(t_bounds, modes, min_duration: float = 0.0) -> list[Phase]:

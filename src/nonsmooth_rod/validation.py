@@ -52,3 +52,25 @@ def require_friction_pair(mu_s, mu_d) -> tuple[float, float]:
             "must not exceed the static one"
         )
     return mu_s, mu_d
+
+
+def require_index(name: str, value) -> int:
+    """A non-negative whole number used as an index (a body number): not 1.5, not True."""
+    if isinstance(value, bool) or not isinstance(value, (int,)) and not (
+            hasattr(value, "__index__") and not isinstance(value, float)):
+        raise InputError(f"{name} must be a whole number (an index), got {value!r}")
+    index = int(value)
+    if index < 0:
+        raise InputError(f"{name} must be non-negative, got {value!r}")
+    return index
+
+
+def require_point(name: str, value) -> tuple[float, float]:
+    """A planar point or vector: exactly two finite numbers."""
+    try:
+        items = list(value)
+    except TypeError:
+        raise InputError(f"{name} must be two numbers (x, y), got {value!r}") from None
+    if len(items) != 2:
+        raise InputError(f"{name} must be two numbers (x, y), got {len(items)}: {value!r}")
+    return (require_finite(f"{name} x", items[0]), require_finite(f"{name} y", items[1]))

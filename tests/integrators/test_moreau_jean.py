@@ -74,7 +74,9 @@ def test_energy_never_grows_with_e0_and_theta_half(case):
 def test_frictionless_rod_keeps_its_centre_of_mass_abscissa():
     run = simulate(RodProblem.paper(None, mu_s=0.0, mu_d=0.0), "moreau-jean", h=1e-4)
     x_com = run.result.trajectory.q[:, 0]
-    assert np.max(np.abs(x_com - x_com[0])) < 1e-14
+    # no horizontal force: x_Γ constant up to round-off of the 3700 position updates (relative to
+    # the body's size; measured 1e-16 m)
+    assert np.max(np.abs(x_com - x_com[0])) < 1e-13 * run.problem.length
 
 
 # --- blocks on inclines: two corner contacts, statically indeterminate when both stick -------

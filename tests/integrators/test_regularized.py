@@ -27,16 +27,16 @@ def test_friction_curves_have_their_documented_shape():
     f = lambda curve, v: friction_coefficient(curve, v, eps, mu_s, mu_d, 10.0)  # noqa: E731
     # Stribeck: 0 at rest, the static peak μs at ε, μd from 10 ε on, odd.
     assert f("stribeck", 0.0) == 0.0
-    assert f("stribeck", eps) == pytest.approx(mu_s, abs=1e-15)
+    assert f("stribeck", eps) == pytest.approx(mu_s, rel=1e-13)
     assert f("stribeck", 5.5 * eps) == pytest.approx(0.5 * (mu_s + mu_d), abs=1e-12)
-    assert f("stribeck", 10 * eps) == pytest.approx(mu_d, abs=1e-15)
-    assert f("stribeck", -3 * eps) == pytest.approx(-f("stribeck", 3 * eps), abs=1e-15)
+    assert f("stribeck", 10 * eps) == pytest.approx(mu_d, rel=1e-13)
+    assert f("stribeck", -3 * eps) == pytest.approx(-f("stribeck", 3 * eps), rel=1e-13)
     assert max(f("stribeck", v) for v in np.linspace(0, 0.05, 2001)) == pytest.approx(mu_s, abs=1e-12)
     # The one-coefficient curves saturate at μd and never reach μs.
     assert f("linear", 0.5 * eps) == pytest.approx(0.5 * mu_d)
     assert f("linear", 3 * eps) == mu_d
     assert f("tanh", eps) == pytest.approx(mu_d * math.tanh(1.0))
-    assert f("tanh", -20 * eps) == pytest.approx(-mu_d, abs=1e-15)
+    assert f("tanh", -20 * eps) == pytest.approx(-mu_d, rel=1e-13)
 
 
 @pytest.mark.parametrize("bad, match", [

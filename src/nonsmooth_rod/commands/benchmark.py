@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 
 from ..validation import InputError
@@ -19,7 +18,7 @@ The full study takes about 4 minutes on 2 cores; --quick about 10 s."""
 
 
 def register(subparsers) -> None:
-    from ..cli import _float, _int
+    from .options import integer as _int, number as _float
 
     p = subparsers.add_parser("benchmark", help="work–precision chart and stability study of every method",
                               description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -104,7 +103,3 @@ def cmd_benchmark(args) -> int:
         + ("" if args.no_extras else ", bistable_map.csv"))
     return 0
 
-
-if __name__ == "__main__":  # pragma: no cover
-    from ..cli import main
-    sys.exit(main(["benchmark", *sys.argv[1:]]))

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..cli import _int
+from .options import image_formats, integer as _int
 from ..validation import InputError
 
 DESCRIPTION = """\
@@ -15,16 +15,6 @@ characteristic times; θ, θ̇, θ̈, x_O, ẋ_O, ẍ_O, N and the actual T/N, r
 --frames/--gif draw the rod itself; --paper-figures writes the Figs. 18-25 set (three friction
 cases, rolling vs sliding hypotheses, angular velocity near the impact) for the folder's body
 (or, without a folder, for the paper's)."""
-
-
-def _formats(text: str) -> tuple[str, ...]:
-    from ..rod.plotting import FORMATS
-
-    fmts = tuple(dict.fromkeys(f.strip().lower() for f in text.split(",") if f.strip()))
-    bad = [f for f in fmts if f not in FORMATS]
-    if not fmts or bad:
-        raise argparse.ArgumentTypeError(f"formats must be among {', '.join(FORMATS)}, got {text!r}")
-    return fmts
 
 
 def register(subparsers) -> None:
@@ -42,7 +32,7 @@ def register(subparsers) -> None:
                    help="also write frames.png: a strip of N poses of the rod (2-48)")
     p.add_argument("--gif", action="store_true", help="also write rod.gif, an animation of the motion")
     p.add_argument("--no-panel", action="store_true", help="do not write the Fig. 14-16 panel")
-    p.add_argument("--format", type=_formats, default=("png", "svg"),
+    p.add_argument("--format", type=image_formats, default=("png", "svg"),
                    help="comma-separated image formats: png, svg (default png,svg)")
     p.add_argument("--dpi", type=_int, default=110, help="resolution of PNG files (default 110)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")

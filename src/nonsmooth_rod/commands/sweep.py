@@ -18,7 +18,7 @@ sweep with the same --out computes only the missing points."""
 
 
 def register(subparsers) -> None:
-    from ..cli import _float, _int, add_physics_options
+    from .options import add_physics_options, integer as _int, number as _float
 
     # The shared physics options define --mu-s/--mu-d/--theta0-deg as single numbers; here they
     # are ranges, so this parser resolves the clash in favour of the definitions below.
@@ -46,7 +46,7 @@ def register(subparsers) -> None:
 
 
 def cmd_sweep(args) -> int:
-    from ..cli import build_problem
+    from .options import build_problem
     from ..rod.plotting import FORMATS
     from ..rod.regime import Grid, SweepSettings, default_jobs, parse_range, sweep
     from ..rod.simulation import METHODS

@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
@@ -173,6 +173,43 @@ class _Contact:
         return gap, u_N, u_T, arm_n, arm_t
 
 
+@dataclass
+class _Record:
+    """What a regularised run collects as it goes."""
+
+    names: list
+    wall0: float
+    cpu0: float
+    stop_index: int | None
+    message: str
+    status: str = "ok"
+    t_stop: float | None = None
+    steps: int = 0
+    max_penetration: float = 0.0
+    next_sample: int = 1
+    grid: np.ndarray = None
+    samples_t: list = field(default_factory=list)
+    samples_y: list = field(default_factory=list)
+    step_sizes: list = field(default_factory=list)
+    events: list = field(default_factory=list)
+    impacts: list = field(default_factory=list)
+    local: list = field(default_factory=list)
+    states: list = field(default_factory=list)
+    changes: list = field(default_factory=list)
+
+
+class _LazyDense:
+    """The step's dense output, built on first use (most steps need none)."""
+
+    def __init__(self, solver):
+        self._solver, self._dense = solver, None
+
+    def __call__(self):
+        if self._dense is None:
+            self._dense = self._solver.dense_output()
+        return self._dense
+
+
 class Regularized:
     """Regularised friction + penalty contact, integrated by a scipy ODE solver step by step."""
 
@@ -242,6 +279,17 @@ class Regularized:
 
     def _run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
         require_positive("t_end", t_end)
+        solver, rec = self._start(scene, q0, v0, t_end)
+        try:
+            while solver.status == "running" and rec.status == "ok" and rec.t_stop is None:
+                self._step(solver, rec)
+        except _TimeLimit:
+            rec.status = "time-limit"
+            rec.message = f"wall-clock limit of {self.options.time_limit:g} s reached at t = {solver.t:.9g} s"
+        return self._finish(solver, rec)
+
+    def _start(self, scene: Scene, q0, v0, t_end: float):
+        """The ODE solver at t = 0 and the record of the run (samples, states, events)."""
         o = self.options
         for c in scene.contacts:
             if not isinstance(c, DiskOnLine):
@@ -253,121 +301,104 @@ class Regularized:
         self._laws = [c.law.friction for c in scene.contacts]
         self._nfev = 0
         names = [c.name for c in scene.contacts]
-        stop_index = names.index(o.stop_at_impact) if o.stop_at_impact in names else None
-        wall0 = time.perf_counter()
-        cpu0 = time.process_time()
-        self._deadline = None if o.time_limit is None else wall0 + o.time_limit
-
+        rec = _Record(names=names, wall0=time.perf_counter(), cpu0=time.process_time(),
+                      stop_index=names.index(o.stop_at_impact) if o.stop_at_impact in names else None,
+                      message=f"reached t_end = {t_end:g} s")
+        self._deadline = None if o.time_limit is None else rec.wall0 + o.time_limit
         y = np.concatenate([np.asarray(q0, float), np.asarray(v0, float)])
         kwargs = dict(rtol=o.rtol, atol=o.atol, max_step=o.max_step)
         if o.first_step is not None:
             kwargs["first_step"] = o.first_step
         solver = ODE_METHODS[o.ode_method](self._rhs, 0.0, y, t_end, **kwargs)
-
         grid = np.arange(0.0, t_end + 0.5 * o.output_dt, o.output_dt)
-        grid = grid[grid <= t_end]
-        samples_t, samples_y = [0.0], [y.copy()]
-        g_next = 1
-        events: list[Event] = []
-        impacts: list[Impact] = []
-        status, message = "ok", f"reached t_end = {t_end:g} s"
-        steps = 0
-        min_h, max_pen = math.inf, 0.0
-        step_sizes = []
-        # Per contact: state now, and the state changes (time, new state).
-        local = [c.local(y, n) for c in self._contacts]
-        states = [self._state_of(g, u) for g, _, u, _, _ in local]
+        rec.grid = grid[grid <= t_end]
+        rec.samples_t, rec.samples_y = [0.0], [y.copy()]
+        rec.local = [c.local(y, n) for c in self._contacts]
+        states = [self._state_of(g, u) for g, _, u, _, _ in rec.local]
         # A contact starting exactly at gap 0 with no approach velocity is resting, not open.
-        states = [("stick" if s == "open" and abs(loc[0]) < 1e-12 else s) for s, loc in zip(states, local)]
-        changes = [[(0.0, s)] for s in states]
-        t_stop = None
-        try:
-            while solver.status == "running":
-                t_old, y_old = solver.t, solver.y.copy()
-                msg = solver.step()
-                if solver.status == "failed":
-                    status = "step-size-collapse"
-                    message = f"{o.ode_method} failed at t = {solver.t:.9g} s: {msg}"
-                    break
-                steps += 1
-                h = solver.t - t_old
-                step_sizes.append(h)
-                min_h = min(min_h, h)
-                y_new = solver.y
-                if not np.all(np.isfinite(y_new)):
-                    status, message = "nan", f"non-finite state at t = {solver.t:.9g} s"
-                    break
-                dense = None
-                new_local = [c.local(y_new, n) for c in self._contacts]
-                # Touchdown of the stop contact: the root of its gap within the step.
-                if stop_index is not None and local[stop_index][0] > 0.0 >= new_local[stop_index][0]:
-                    dense = solver.dense_output()
-                    c = self._contacts[stop_index]
-                    t_hit = brentq(lambda tt: c.local(dense(tt), n)[0], t_old, solver.t, xtol=1e-14, rtol=1e-15)
-                    y_hit = dense(t_hit)
-                    impacts.append(Impact(t_hit, names[stop_index], y_hit[:n].copy(), y_hit[n:].copy(),
-                                          y_hit[n:].copy(), np.zeros(len(names)), np.zeros(len(names))))
-                    events.append(Event(t_hit, "impact", names[stop_index], {"model": "penalty"}))
-                    t_stop = t_hit
-                # Contact-state changes within the step, located on the dense output.
-                t_limit = t_stop if t_stop is not None else solver.t
-                for ci, c in enumerate(self._contacts):
-                    new_state = self._state_of(new_local[ci][0], new_local[ci][2])
-                    if new_state != states[ci]:
-                        dense = dense or solver.dense_output()
-                        t_change = self._locate(c, dense, t_old, t_limit, states[ci], new_state)
-                        changes[ci].append((t_change, new_state))
-                        states[ci] = new_state
-                    max_pen = max(max_pen, -new_local[ci][0])
-                # Output samples inside the step.
-                while g_next < grid.size and grid[g_next] <= t_limit:
-                    dense = dense or solver.dense_output()
-                    samples_t.append(float(grid[g_next]))
-                    samples_y.append(dense(grid[g_next]))
-                    g_next += 1
-                local = new_local
-                if t_stop is not None:
-                    samples_t.append(t_stop)
-                    samples_y.append(dense(t_stop))
-                    status, message = "ok", f"stopped at the touchdown of {o.stop_at_impact}"
-                    break
-                if max_pen > o.max_penetration:
-                    status = "penetration"
-                    message = (f"penetration {max_pen:.3g} m exceeds {o.max_penetration:g} m at "
-                               f"t = {solver.t:.9g} s")
-                    break
-        except _TimeLimit:
-            status = "time-limit"
-            message = f"wall-clock limit of {o.time_limit:g} s reached at t = {solver.t:.9g} s"
-        t_final = t_stop if t_stop is not None else float(solver.t)
-        if samples_t[-1] < t_final and status != "ok":
-            samples_t.append(float(solver.t))
-            samples_y.append(solver.y.copy())
-        elif status == "ok" and t_stop is None and samples_t[-1] < t_final:
-            samples_t.append(t_final)
-            samples_y.append(solver.y.copy())
-        nfev = self._nfev
-        traj = self._trajectory(samples_t, samples_y)
-        phases = {}
-        for ci, name in enumerate(names):
-            ph = []
-            for j, (ts, st) in enumerate(changes[ci]):
-                te = changes[ci][j + 1][0] if j + 1 < len(changes[ci]) else t_final
-                if te > ts or not ph:
-                    ph.append(Phase(st, ts, max(te, ts)))
-            phases[name] = merge_short_phases(ph, o.min_phase)
-        cpu = time.process_time() - cpu0
-        if status != "ok":
-            events.append(Event(t_final, status, "", {"message": message}))
-        h_arr = np.array(step_sizes) if step_sizes else np.array([np.nan])
-        stats = {"nfev": nfev, "njev": int(getattr(solver, "njev", 0)), "nlu": int(getattr(solver, "nlu", 0)),
-                 "steps": steps, "min_step": float(np.min(h_arr)), "median_step": float(np.median(h_arr)),
-                 "max_penetration": max_pen, "t_final": t_final, "wall_time_s": time.perf_counter() - wall0,
-                 "epsilon": o.epsilon, "friction_curve": o.friction_curve, "ode_method": o.ode_method,
-                 "rtol": o.rtol, "atol": o.atol}
-        self.step_sizes = np.array(step_sizes)  # kept for step-size histories
-        return SimulationResult(self.name, status, message, traj, names, events, impacts, phases,
-                                steps=steps, cpu_time_s=cpu, stats=stats)
+        rec.states = [("stick" if s == "open" and abs(loc[0]) < 1e-12 else s) for s, loc in zip(states, rec.local)]
+        rec.changes = [[(0.0, s)] for s in rec.states]
+        return solver, rec
+
+    def _step(self, solver, rec) -> None:
+        """One accepted step: touchdown of the stop contact, state changes, output samples."""
+        o, n = self.options, self._n_dof
+        t_old = solver.t
+        msg = solver.step()
+        if solver.status == "failed":
+            rec.status, rec.message = "step-size-collapse", f"{o.ode_method} failed at t = {solver.t:.9g} s: {msg}"
+            return
+        rec.steps += 1
+        rec.step_sizes.append(solver.t - t_old)
+        if not np.all(np.isfinite(solver.y)):
+            rec.status, rec.message = "nan", f"non-finite state at t = {solver.t:.9g} s"
+            return
+        dense = _LazyDense(solver)
+        new_local = [c.local(solver.y, n) for c in self._contacts]
+        if rec.stop_index is not None and rec.local[rec.stop_index][0] > 0.0 >= new_local[rec.stop_index][0]:
+            self._touchdown(rec, dense, t_old, solver.t)
+        t_limit = rec.t_stop if rec.t_stop is not None else solver.t
+        for ci, c in enumerate(self._contacts):
+            new_state = self._state_of(new_local[ci][0], new_local[ci][2])
+            if new_state != rec.states[ci]:
+                rec.changes[ci].append((self._locate(c, dense(), t_old, t_limit, rec.states[ci], new_state),
+                                        new_state))
+                rec.states[ci] = new_state
+            rec.max_penetration = max(rec.max_penetration, -new_local[ci][0])
+        while rec.next_sample < rec.grid.size and rec.grid[rec.next_sample] <= t_limit:
+            rec.samples_t.append(float(rec.grid[rec.next_sample]))
+            rec.samples_y.append(dense()(rec.grid[rec.next_sample]))
+            rec.next_sample += 1
+        rec.local = new_local
+        if rec.t_stop is not None:
+            rec.samples_t.append(rec.t_stop)
+            rec.samples_y.append(dense()(rec.t_stop))
+            rec.message = f"stopped at the touchdown of {o.stop_at_impact}"
+        elif rec.max_penetration > o.max_penetration:
+            rec.status = "penetration"
+            rec.message = (f"penetration {rec.max_penetration:.3g} m exceeds {o.max_penetration:g} m at "
+                           f"t = {solver.t:.9g} s")
+
+    def _touchdown(self, rec, dense, t_old: float, t_new: float) -> None:
+        """The stop contact's gap closed within the step: its root on the dense output."""
+        n, i = self._n_dof, rec.stop_index
+        c = self._contacts[i]
+        t_hit = brentq(lambda tt: c.local(dense()(tt), n)[0], t_old, t_new, xtol=1e-14, rtol=1e-15)
+        y_hit = dense()(t_hit)
+        nc = len(rec.names)
+        rec.impacts.append(Impact(t_hit, rec.names[i], y_hit[:n].copy(), y_hit[n:].copy(), y_hit[n:].copy(),
+                                  np.zeros(nc), np.zeros(nc)))
+        rec.events.append(Event(t_hit, "impact", rec.names[i], {"model": "penalty"}))
+        rec.t_stop = t_hit
+
+    def _finish(self, solver, rec) -> SimulationResult:
+        o = self.options
+        t_final = rec.t_stop if rec.t_stop is not None else float(solver.t)
+        if rec.samples_t[-1] < t_final and rec.t_stop is None:
+            rec.samples_t.append(float(solver.t))
+            rec.samples_y.append(solver.y.copy())
+        traj = self._trajectory(rec.samples_t, rec.samples_y)
+        phases = {name: self._phases(rec.changes[ci], t_final) for ci, name in enumerate(rec.names)}
+        if rec.status != "ok":
+            rec.events.append(Event(t_final, rec.status, "", {"message": rec.message}))
+        h_arr = np.array(rec.step_sizes) if rec.step_sizes else np.array([np.nan])
+        stats = {"nfev": self._nfev, "njev": int(getattr(solver, "njev", 0)), "nlu": int(getattr(solver, "nlu", 0)),
+                 "steps": rec.steps, "min_step": float(np.min(h_arr)), "median_step": float(np.median(h_arr)),
+                 "max_penetration": rec.max_penetration, "t_final": t_final,
+                 "wall_time_s": time.perf_counter() - rec.wall0, "epsilon": o.epsilon,
+                 "friction_curve": o.friction_curve, "ode_method": o.ode_method, "rtol": o.rtol, "atol": o.atol}
+        self.step_sizes = np.array(rec.step_sizes)  # kept for step-size histories
+        return SimulationResult(self.name, rec.status, rec.message, traj, rec.names, rec.events, rec.impacts,
+                                phases, steps=rec.steps, cpu_time_s=time.process_time() - rec.cpu0, stats=stats)
+
+    def _phases(self, changes, t_final: float) -> list[Phase]:
+        """One contact's phases from its state changes (time, new state)."""
+        ph = []
+        for j, (ts, st) in enumerate(changes):
+            te = changes[j + 1][0] if j + 1 < len(changes) else t_final
+            if te > ts or not ph:
+                ph.append(Phase(st, ts, max(te, ts)))
+        return merge_short_phases(ph, self.options.min_phase)
 
     def _locate(self, c: _Contact, dense, t0, t1, old, new) -> float:
         """Time within [t0, t1] at which the contact left state `old` (root of the boundary)."""

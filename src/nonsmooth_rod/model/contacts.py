@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..validation import InputError, require_finite, require_nonnegative
+from ..validation import InputError, require_finite, require_index, require_nonnegative, require_point
 from .body import cross2, rotate
 from .laws import ContactLaw
 
@@ -38,8 +38,7 @@ class Line:
     def __post_init__(self):
         require_finite("line angle", self.angle)
         require_finite("line velocity", self.velocity)
-        for c in self.point:
-            require_finite("line point", c)
+        object.__setattr__(self, "point", require_point("line point", self.point))
 
     @property
     def tangent(self) -> tuple[float, float]:
@@ -48,6 +47,17 @@ class Line:
     @property
     def normal(self) -> tuple[float, float]:
         return (-math.sin(self.angle), math.cos(self.angle))
+
+
+def _contact_name(name) -> str:
+    if not isinstance(name, str) or not name:
+        raise InputError(f"a contact name must be a non-empty string, got {name!r}")
+    return name
+
+
+def _require_type(name: str, value, cls) -> None:
+    if not isinstance(value, cls):
+        raise InputError(f"{name} must be a {cls.__name__}, got {type(value).__name__}")
 
 
 @dataclass
@@ -78,9 +88,16 @@ class DiskOnLine:
     name: str = "contact"
 
     def __post_init__(self):
-        require_nonnegative(f"{self.name} radius", self.radius)
-        if self.body < 0:
-            raise InputError(f"{self.name}: body index must be non-negative")
+        self.name = _contact_name(self.name)
+        self.body = require_index(f"contact {self.name!r} body", self.body)
+        self.offset = require_point(f"contact {self.name!r} offset", self.offset)
+        self.radius = require_nonnegative(f"contact {self.name!r} radius", self.radius)
+        _require_type(f"contact {self.name!r} line", self.line, Line)
+        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return (self.body,)
 
     def kinematics(self, q: np.ndarray, v: np.ndarray, n_dof: int) -> ContactKinematics:
         i = 3 * self.body
@@ -123,12 +140,21 @@ class DiskOnDisk:
     name: str = "disk-disk"
 
     def __post_init__(self):
-        require_nonnegative(f"{self.name} radius_a", self.radius_a)
-        require_nonnegative(f"{self.name} radius_b", self.radius_b)
-        if self.body_a < 0 or self.body_b < 0:
-            raise InputError(f"{self.name}: body indices must be non-negative")
+        self.name = _contact_name(self.name)
+        self.body_a = require_index(f"contact {self.name!r} body_a", self.body_a)
+        self.body_b = require_index(f"contact {self.name!r} body_b", self.body_b)
+        self.radius_a = require_nonnegative(f"contact {self.name!r} radius_a", self.radius_a)
+        self.radius_b = require_nonnegative(f"contact {self.name!r} radius_b", self.radius_b)
+        self.offset_a = require_point(f"contact {self.name!r} offset_a", self.offset_a)
+        self.offset_b = require_point(f"contact {self.name!r} offset_b", self.offset_b)
+        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
         if self.body_a == self.body_b:
-            raise InputError(f"{self.name}: a disk–disk contact joins two different bodies")
+            raise InputError(f"contact {self.name!r}: a disk–disk contact joins two different bodies, "
+                             f"got body_a = body_b = {self.body_a}")
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return (self.body_a, self.body_b)
 
     def kinematics(self, q: np.ndarray, v: np.ndarray, n_dof: int) -> ContactKinematics:
         ia, ib = 3 * self.body_a, 3 * self.body_b

@@ -33,10 +33,31 @@ class Scene:
             raise InputError("a scene needs at least one body")
         self.bodies = list(self.bodies)
         self.contacts = list(self.contacts)
+        self._check_references()
         self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
         self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
         self.weight = np.zeros(self.n_dof)
         self.weight[1::3] = -self.gravity * self.mass_diagonal[0::3]
+
+    def _check_references(self) -> None:
+        """Every contact names bodies that exist; contact names are unique (phases are keyed by them)."""
+        if self.applied_force is not None and not callable(self.applied_force):
+            raise InputError(f"applied_force must be a callable (t, q, v) -> force, got {self.applied_force!r}")
+        for body in self.bodies:
+            if not isinstance(body, RigidBody):
+                raise InputError(f"scene bodies must be RigidBody, got {type(body).__name__}")
+        seen = set()
+        for contact in self.contacts:
+            if not hasattr(contact, "bodies") or not hasattr(contact, "kinematics"):
+                raise InputError(f"scene contacts must be contact relations (DiskOnLine, PointOnLine, "
+                                 f"DiskOnDisk), got {type(contact).__name__}")
+            for body in contact.bodies:
+                if body >= len(self.bodies):
+                    raise InputError(f"contact {contact.name!r} refers to body {body}, but the scene has "
+                                     f"{len(self.bodies)} bodies (0 to {len(self.bodies) - 1})")
+            if contact.name in seen:
+                raise InputError(f"two contacts are named {contact.name!r}: contact names must be unique")
+            seen.add(contact.name)
 
     @property
     def n_dof(self) -> int:
@@ -45,7 +66,11 @@ class Scene:
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         if self.applied_force is None:
             return self.weight
-        return self.weight + np.asarray(self.applied_force(t, q, v), dtype=float)
+        force = np.asarray(self.applied_force(t, q, v), dtype=float)
+        if force.shape != self.weight.shape:
+            raise InputError(f"applied_force must return {self.n_dof} numbers (fx, fy, torque per body), "
+                             f"got shape {force.shape} at t = {t:g} s")
+        return self.weight + force
 
     def kinematics(self, q: np.ndarray, v: np.ndarray):
         return [c.kinematics(q, v, self.n_dof) for c in self.contacts]

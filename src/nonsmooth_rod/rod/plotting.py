@@ -10,7 +10,6 @@ regime-coloured pieces into the plotted arrays, so tests can compare them with t
 """
 from __future__ import annotations
 
-import io
 import json
 import math
 from dataclasses import dataclass
@@ -212,15 +211,8 @@ def save_figure(fig: Figure, path, formats=("png",), dpi: int = 110) -> list[Pat
 
 
 def _save_png(fig: Figure, path, dpi: int) -> None:
-    """PNG with a 256-colour palette: line plots hold few colours, so nothing visible changes
-    and the file is about a third of the size (figures are meant to be committed)."""
-    from PIL import Image
-
-    buf = io.BytesIO()
-    fig.savefig(buf, dpi=dpi, format="png")
-    buf.seek(0)
-    with Image.open(buf) as im:
-        im.convert("RGB").quantize(colors=256).save(path, format="PNG", optimize=True)
+    """A lossless PNG (publication figures keep every colour matplotlib drew)."""
+    fig.savefig(path, dpi=dpi, format="png")
 
 
 def _fmt_time(t) -> str:

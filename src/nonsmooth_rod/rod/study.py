@@ -302,7 +302,8 @@ def _child(spec, ref, time_limit, conn):
 
 
 def _warm_up(specs) -> None:
-    """Compile Moreau–Jean's fast path once here, so forked runs do not pay for it."""
+    """Compile Moreau–Jean's fast path once here: forked children inherit it, spawned ones load
+    it from numba's on-disk cache instead of compiling it again."""
     if any(s.method == "moreau-jean" for s in specs):
         from .simulation import simulate
         simulate(RodProblem.paper(2), "moreau-jean", h=1e-2, solver="lemke")
@@ -316,7 +317,7 @@ def run_specs(specs: list[RunSpec], refs: dict, time_limit: float, workers: int 
         raise InputError(f"time limit must be positive, got {time_limit!r}")
     workers = max(1, int(workers))
     _warm_up(specs)
-    ctx = multiprocessing.get_context("fork")
+    ctx = multiprocessing.get_context()  # the platform's default start method (no fork on macOS/Windows)
     pending = list(enumerate(specs))
     running: dict[int, tuple] = {}
     results: list[dict | None] = [None] * len(specs)

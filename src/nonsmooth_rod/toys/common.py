@@ -6,8 +6,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..integrators.event_driven import EventDriven, EventDrivenOptions
-from ..integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from ..io import atomic_path
 from ..model.body import RigidBody, cross2, rotate
 from ..model.contacts import Line, PointOnLine
@@ -22,19 +20,19 @@ G = 9.81
 def run(toy, method: str = "moreau-jean", t_end: float = 1.0, *, h: float = 1e-3, theta: float = 0.5,
         solver: str = "lemke", rtol: float = 1e-12, output_dt: float = 1e-3,
         zeno_interval: float = 1e-9, fast: bool = True) -> SimulationResult:
-    """Run a toy from its initial state with Moreau–Jean ("moreau-jean", step h, θ, one-step
-    solver; `fast` allows its compiled loop where the scene permits) or the event-driven
-    reference ("event-driven", tolerance rtol, samples every output_dt)."""
-    scene = toy.scene()
+    """Run a toy from its initial state through `nonsmooth_rod.simulate`: Moreau–Jean
+    ("moreau-jean", step h, θ, one-step solver; `fast` allows its compiled loop) or the
+    event-driven reference ("event-driven", tolerance rtol, samples every output_dt)."""
+    from ..driver import simulate
+
     q0, v0 = toy.initial_state()
     if method == "moreau-jean":
-        integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, fast=fast))
+        options = dict(h=h, theta=theta, solver=solver, fast=fast)
     elif method == "event-driven":
-        integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, output_dt=output_dt,
-                                                    zeno_interval=zeno_interval))
+        options = dict(rtol=rtol, atol=rtol, output_dt=output_dt, zeno_interval=zeno_interval)
     else:
         raise InputError(f"unknown method '{method}'; choose moreau-jean or event-driven")
-    return integrator.run(scene, q0, v0, t_end)
+    return simulate(toy.scene(), q0, v0, t_end, method, **options)
 
 
 def _rectangle_inertia(mass: float, width: float, height: float) -> float:
@@ -105,5 +103,6 @@ def example_parser(description: str):
     import argparse
 
     parser = argparse.ArgumentParser(description=description)
-    parser.add_argument("--out", default=".", help="folder for the figure (default: current folder)")
+    parser.add_argument("--out", default="results/examples",
+                        help="folder for the figure (default: ./results/examples)")
     return parser

@@ -1,0 +1,204 @@
+"""The one driver: `simulate(scene, q0, v0, t_end, method=..., **options)`.
+
+In the spirit of scipy's `solve_ivp` and diffrax's `diffeqsolve`: one call, the method picked
+by name, its options passed through by keyword, one result type whatever the method. The
+driver validates everything once (the state, the times, the options, whether the method
+handles the scene's contacts, whether the output fits in memory), so the integrators — and
+the compiled loop — can trust their inputs.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._jit import compiling_notice
+from .integrators import METHODS, integrator_classes, supported_contacts
+from .model.scene import Scene
+from .results import Event, SimulationResult, Status, Trajectory
+from .validation import InputError, require_finite, require_positive
+
+# Refuse a run whose saved output would exceed this (bytes), before allocating anything.
+MAX_OUTPUT_BYTES = 4 * 2**30
+
+
+@dataclass(frozen=True)
+class StopAtImpact:
+    """Stop condition: end the run at the first impact of the named contact."""
+
+    contact: str
+
+
+def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *, t0: float = 0.0,
+             save_every: float | None = None, stop=None, **options) -> SimulationResult:
+    """Simulate `scene` from (q0, v0) at time t0 to t_end with the named method.
+
+    method: "moreau-jean" (options h, theta, solver, solver_options, activation_gamma,
+    min_phase, fast), "event-driven" (rtol, atol, max_step, output_dt, ...) or "regularized"
+    (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping, time_limit, ...).
+    save_every: keep one sample per this many seconds (default: every step / output_dt).
+    stop: a contact name or `StopAtImpact(name)` (the run ends at that contact's first
+    impact), a callable (t, q, v) -> bool (the run ends at the first saved sample where it is
+    true, status "stopped"), or a list of these.
+    Bad input raises InputError naming the argument; a run that fails returns a result with
+    status "failed" and a message saying where and why.
+    """
+    if not isinstance(scene, Scene):
+        raise InputError(f"scene must be a nonsmooth_rod.Scene, got {type(scene).__name__}")
+    q0 = _state_vector("q0", q0, scene.n_dof)
+    v0 = _state_vector("v0", v0, scene.n_dof)
+    t0 = require_finite("t0", t0)
+    t_end = require_finite("t_end", t_end)
+    if t_end <= t0:
+        raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
+    integrator_cls, options_cls = _method(method, scene)
+    impact_stops, callables = _stop_conditions(stop, scene)
+    opts = _options(options_cls, method, options, impact_stops)
+    _check_output_size(method, opts, scene, t_end - t0, save_every)
+    run_scene = _shifted(scene, t0)
+    with compiling_notice(active=method == "moreau-jean" and getattr(opts, "fast", False)):
+        result = integrator_cls(opts).run(run_scene, q0, v0, t_end - t0)
+    result.method = method
+    if t0:
+        _shift_times(result, t0)
+    if callables:
+        _apply_stop(result, callables)
+    if save_every is not None:
+        _decimate(result, require_positive("save_every", save_every))
+    return result
+
+
+def _state_vector(name: str, value, n_dof: int) -> np.ndarray:
+    if value is None:
+        raise InputError(f"{name} must be a sequence of {n_dof} numbers (x, y, θ per body), got None")
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a sequence of {n_dof} numbers, got {value!r}") from None
+    if arr.shape != (n_dof,):
+        raise InputError(f"{name} must hold {n_dof} numbers (x, y, θ per body), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"{name} must be finite, got {arr.tolist()!r}")
+    return arr.copy()
+
+
+def _method(method, scene: Scene):
+    if method not in METHODS:
+        raise InputError(f"unknown method {method!r}; choose from: {', '.join(METHODS)}")
+    handled = supported_contacts(method)
+    for contact in scene.contacts:
+        if type(contact).__name__ not in handled:
+            raise InputError(f"method {method!r} does not handle {type(contact).__name__} contacts "
+                             f"(contact {contact.name!r}); it handles {', '.join(handled)}")
+    return integrator_classes(method)
+
+
+def _stop_conditions(stop, scene: Scene):
+    """Split stop conditions into impact names (the integrators stop themselves) and callables."""
+    items = [] if stop is None else (list(stop) if isinstance(stop, (list, tuple)) else [stop])
+    names = [c.name for c in scene.contacts]
+    impacts, callables = [], []
+    for item in items:
+        name = item.contact if isinstance(item, StopAtImpact) else item if isinstance(item, str) else None
+        if name is not None:
+            if name not in names:
+                raise InputError(f"stop: no contact named {name!r}; contacts: {', '.join(names) or 'none'}")
+            impacts.append(name)
+        elif callable(item):
+            callables.append(item)
+        else:
+            raise InputError(f"stop must be a contact name, StopAtImpact or a callable, got {item!r}")
+    if len(impacts) > 1:
+        raise InputError(f"stop: one impact condition at a time, got {impacts}")
+    return impacts, callables
+
+
+def _options(options_cls, method: str, options: dict, impact_stops: list):
+    valid = [f.name for f in dataclasses.fields(options_cls) if f.name != "stop_at_impact"]
+    for key in options:
+        if key not in valid:
+            raise InputError(f"unknown option {key!r} for method {method!r}; options: {', '.join(valid)}")
+    if impact_stops:
+        options = dict(options, stop_at_impact=impact_stops[0])
+    try:
+        return options_cls(**options)
+    except InputError:
+        raise
+    except (TypeError, ValueError) as err:
+        raise InputError(f"invalid option for method {method!r}: {err}") from None
+
+
+def _check_output_size(method: str, opts, scene: Scene, duration: float, save_every) -> None:
+    """Refuse, before allocating, a run whose samples cannot fit in memory."""
+    if method == "moreau-jean":
+        samples, knob = duration / opts.h, "a larger h or a shorter t_end"
+    else:
+        samples, knob = duration / opts.output_dt, "a coarser output_dt or a shorter t_end"
+    per_sample = 8 * (3 * scene.n_dof + 3 * len(scene.contacts)) + 8
+    needed = samples * per_sample
+    if not math.isfinite(needed) or needed > MAX_OUTPUT_BYTES:
+        raise InputError(f"the run would keep {samples:.3g} samples ({needed / 2**30:.3g} GiB), over the "
+                         f"{MAX_OUTPUT_BYTES / 2**30:g} GiB limit: use {knob}")
+
+
+def _shifted(scene: Scene, t0: float) -> Scene:
+    """The scene with time-dependent applied forces read at t0 + t (integrators start at 0)."""
+    if not t0 or scene.applied_force is None:
+        return scene
+    force = scene.applied_force
+    return dataclasses.replace(scene, applied_force=lambda t, q, v: force(t + t0, q, v))
+
+
+def _shift_times(result: SimulationResult, t0: float) -> None:
+    result.trajectory.t = result.trajectory.t + t0
+    for event in result.events:
+        event.t += t0
+    for impact in result.impacts:
+        impact.t += t0
+    for phases in result.phases.values():
+        for phase in phases:
+            phase.t_start += t0
+            phase.t_end += t0
+
+
+def _apply_stop(result: SimulationResult, conditions) -> None:
+    """End the result at the first sample where any condition holds."""
+    tr = result.trajectory
+    for k in range(len(tr.t)):
+        if any(bool(cond(float(tr.t[k]), tr.q[k].copy(), tr.v[k].copy())) for cond in conditions):
+            t_stop = float(tr.t[k])
+            _truncate(result, k + 1)
+            result.events.append(Event(t_stop, "stop", "", {}))
+            result.set_status(Status.STOPPED, f"a stop condition held at t = {t_stop:.9g} s")
+            return
+
+
+def _truncate(result: SimulationResult, n: int) -> None:
+    tr = result.trajectory
+    t_last = float(tr.t[n - 1])
+    result.trajectory = Trajectory(tr.t[:n], tr.q[:n], tr.v[:n], tr.a[:n], tr.normal_force[:n],
+                                   tr.tangential_force[:n], tr.modes[:n])
+    result.events = [e for e in result.events if e.t <= t_last]
+    result.impacts = [i for i in result.impacts if i.t <= t_last]
+    for name, phases in result.phases.items():
+        kept = [p for p in phases if p.t_start < t_last]
+        if kept:
+            kept[-1].t_end = min(kept[-1].t_end, t_last)
+        result.phases[name] = kept
+
+
+def _decimate(result: SimulationResult, save_every: float) -> None:
+    """Keep the first sample, then one per `save_every` seconds, and the last one."""
+    tr = result.trajectory
+    if len(tr.t) < 3:
+        return
+    slots = np.floor((tr.t - tr.t[0]) / save_every + 1e-9)
+    keep = np.r_[True, slots[1:] != slots[:-1]]
+    keep[-1] = True
+    result.trajectory = Trajectory(tr.t[keep], tr.q[keep], tr.v[keep], tr.a[keep], tr.normal_force[keep],
+                                   tr.tangential_force[keep], tr.modes[keep])
+
+
+__all__ = ["simulate", "StopAtImpact", "MAX_OUTPUT_BYTES"]
