@@ -11,16 +11,12 @@ bodies are body0, body1, ... and contacts keep the result's contact names.
 """
 from __future__ import annotations
 
-import datetime
 import hashlib
-import platform
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .io import read_csv, write_csv, write_json, write_text
+from .io import provenance, read_csv, write_csv, write_json, write_text
 from .results import Event, Impact, Phase, SimulationResult, Trajectory
 from .validation import InputError
 
@@ -49,18 +45,6 @@ def trajectory_columns(result) -> dict:
         cols[f"{name}.T"] = tr.tangential_force[:, k]
         cols[f"{name}.mode"] = [str(m) for m in tr.modes[:, k]]
     return cols
-
-
-def provenance(command=None) -> dict:
-    def version(module):
-        try:
-            return __import__(module).__version__
-        except ImportError:
-            return None
-
-    return {"version": __version__, "command": command if command is not None else " ".join(sys.argv),
-            "python": platform.python_version(), "numpy": version("numpy"), "scipy": version("scipy"),
-            "numba": version("numba"), "created": datetime.datetime.now(datetime.timezone.utc).isoformat()}
 
 
 def _by_name(names, values) -> dict:
@@ -205,22 +189,6 @@ def restart(source, t: float, t_end: float | None = None):
     if t_end <= t0:
         raise InputError(f"t_end = {t_end:g} s must exceed the restart time {t0:g} s")
     q0, v0 = result.trajectory.q[k].copy(), result.trajectory.v[k].copy()
-    try:
-        again = run_method(sf.scene, q0, v0, t_end, sf.method, sf.options, sf.stop, t0=t0)
-    except InputError:
-        if sf.force_names:
-            raise
-        again = _shifted(run_method(sf.scene, q0, v0, t_end - t0, sf.method, sf.options, sf.stop), t0)
+    again = run_method(sf.scene, q0, v0, t_end, sf.method, sf.options, sf.stop, t0=t0)
     again.scene_file = sf
     return again
-
-
-def _shifted(result, t0: float):
-    """A run of a time-invariant scene started at 0, moved to start at t0."""
-    result.trajectory.t = np.asarray(result.trajectory.t) + t0
-    for phases in result.phases.values():
-        for ph in phases:
-            ph.t_start, ph.t_end = ph.t_start + t0, ph.t_end + t0
-    for item in list(result.impacts) + list(result.events):
-        item.t = item.t + t0
-    return result

@@ -22,6 +22,7 @@ from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, Line
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
+from .integrators import METHODS
 from .validation import InputError
 
 try:
@@ -30,7 +31,6 @@ except ModuleNotFoundError:  # Python 3.10: the backport (dependency `tomli; pyt
     import tomli as tomllib
 
 SCHEMA = "nonsmooth-rod/scene/1"
-METHODS = ("moreau-jean", "event-driven", "regularized")
 SHAPES = ("disk", "ball", "rectangle", "rod", "rod-with-balls")
 CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk")
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9_+\-]+$")
@@ -386,13 +386,9 @@ def _check_overlap(w, scene, q0, v0) -> None:
 # --- simulation settings ----------------------------------------------------------------------------
 
 def _options_class(method: str):
-    if method == "moreau-jean":
-        from .integrators.moreau_jean import MoreauJeanOptions as cls
-    elif method == "event-driven":
-        from .integrators.event_driven import EventDrivenOptions as cls
-    else:
-        from .integrators.regularized import RegularizedOptions as cls
-    return cls
+    from .integrators import integrator_classes
+
+    return integrator_classes(method)[1]
 
 
 def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
@@ -414,21 +410,8 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
     options = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop")}
     _check_keys(w, options, allowed, "simulation")
     _check_options(w, cls, options, stop)
-    _check_output_size(w, method, t_end, options, cls)
     return method, t_end, options, stop
 
-
-MAX_SAMPLES = 50_000_000  # ~ 2 GB for a one-body, two-contact scene: beyond it the run cannot be held
-
-
-def _check_output_size(w, method, t_end, options, cls) -> None:
-    """Refuse up front a run whose samples cannot fit in memory (naming the option that fixes it)."""
-    key = "h" if method == "moreau-jean" else "output_dt"
-    spacing = options.get(key, getattr(cls(), key))
-    samples = t_end / spacing
-    if samples > MAX_SAMPLES:
-        raise w.error(f"simulation.{key}", f"t_end / {key} = {samples:.3g} samples exceed {MAX_SAMPLES:.0e}: "
-                                           f"raise {key} or shorten t_end")
 
 
 def _check_options(w, cls, options: dict, stop: list) -> None:
@@ -537,28 +520,18 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
 # --- running ----------------------------------------------------------------------------------------
 
 def run_method(scene, q0, v0, t_end: float, method: str, options: dict, stop=(), t0: float = 0.0):
-    """The one place that calls an integrator: nr.simulate once the driver is in this branch."""
-    try:
-        from .driver import simulate
-    except ImportError:
-        simulate = None
-    if simulate is not None:
-        return simulate(scene, q0, v0, t_end, method, t0=t0, stop=list(stop) or None, **options)
-    if t0 != 0.0:
-        raise InputError("restarting at t0 > 0 needs nr.simulate (the driver), not yet in this build")
-    cls = _options_class(method)
-    opts = cls(**options, stop_at_impact=stop[0] if stop else None)
-    if method == "moreau-jean":
-        from .integrators.moreau_jean import MoreauJean as integrator
-    elif method == "event-driven":
-        from .integrators.event_driven import EventDriven as integrator
-    else:
-        from .integrators.regularized import Regularized as integrator
-    return integrator(opts).run(scene, np.asarray(q0, float), np.asarray(v0, float), t_end)
+    """The one place that runs a scene file's scene: nr.simulate."""
+    from .driver import simulate
+
+    return simulate(scene, q0, v0, t_end, method, t0=t0, stop=list(stop) or None, **options)
 
 
 def simulate_scene(sf: SceneFile):
-    """Run a loaded scene file with its own method, options and stop conditions."""
-    result = run_method(sf.scene, sf.q0, sf.v0, sf.t_end, sf.method, sf.options, sf.stop)
+    """Run a loaded scene file with its own method, options and stop conditions; a refusal by the
+    driver (a method that does not handle a contact kind, a run too large for memory) names the file."""
+    try:
+        result = run_method(sf.scene, sf.q0, sf.v0, sf.t_end, sf.method, sf.options, sf.stop)
+    except InputError as err:
+        raise InputError(f"{sf.source}: simulation: {err}") from None
     result.scene_file = sf  # names and shapes for files, figures and animations
     return result
