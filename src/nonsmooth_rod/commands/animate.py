@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..validation import InputError
+from .options import integer
 
 
 def register(subparsers) -> None:
@@ -13,8 +14,8 @@ def register(subparsers) -> None:
                                           "(and animation.mp4 where ffmpeg is installed).")
     p.add_argument("folder", help="results folder (summary.json, trajectory.csv and the scene copy)")
     p.add_argument("--out", default=None, help="where to write the animation (default: the results folder)")
-    p.add_argument("--frames", type=int, default=120, help="number of frames (2-2000, default 120)")
-    p.add_argument("--fps", type=int, default=25, help="frames per second (1-120, default 25)")
+    p.add_argument("--frames", type=integer, default=120, help="number of frames (2-2000, default 120)")
+    p.add_argument("--fps", type=integer, default=25, help="frames per second (1-120, default 25)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=cmd_animate)
 

@@ -11,6 +11,8 @@ import os
 import sys
 from pathlib import Path
 
+from .options import EXIT_OK, EXIT_RUN_FAILED, add_output_options, escape
+
 DESCRIPTION = """\
 Simulate the scene described in a scene file (TOML or JSON, schema nonsmooth-rod/scene/1,
 see docs/scene-format.md). Writes trajectory.csv, summary.json, a copy of the scene file and
@@ -25,11 +27,8 @@ def register(subparsers) -> None:
     p.add_argument("scene", help="scene file (.toml, or .json)")
     p.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
                    help="override a value of the scene file (repeatable), e.g. contacts.floor.law.mu_s=0.3")
-    p.add_argument("--out", default="results", help="output folder (default ./results)")
-    p.add_argument("--json", action="store_true", help="print the summary JSON on stdout and nothing else there")
-    p.add_argument("--no-plot", action="store_true", help="do not write figure.png")
+    add_output_options(p)
     p.add_argument("--animate", action="store_true", help="also write animation.gif (and animation.mp4 with ffmpeg)")
-    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=cmd_run)
 
 
@@ -53,7 +52,6 @@ def _fmt(x: float) -> str:
 
 def print_report(result, out_dir, console) -> None:
     """Phase table per contact, the impacts, the status line (rich; '[s]' escaped from markup)."""
-    from rich.markup import escape
     from rich.table import Table
 
     table = Table(title=f"{result.method}: phases per contact")
@@ -112,5 +110,5 @@ def cmd_run(args) -> int:
         print_report(result, out_dir, console)
     if not result.success:
         print(f"nonsmooth-rod: run ended with status '{_status(result)}': {result.message}", file=sys.stderr)
-        return 1
-    return 0
+        return EXIT_RUN_FAILED
+    return EXIT_OK
