@@ -20,6 +20,7 @@ import numpy as np
 
 from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, Line
+from .model import shapes
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
 from .integrators import METHODS
@@ -195,11 +196,9 @@ def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
     if shape is None:
         return {}, None, None
     if shape == "rod-with-balls":
-        from .rod.problem import RodGeometry
-
         dims = {k: _number(w, t, k, key, positive=True) for k in ("ball_radius", "rod_diameter", "length", "density")}
         try:
-            mass, _, inertia = RodGeometry(**dims).inertial_properties()
+            mass, inertia = shapes.rod_with_balls(**dims)
         except InputError as err:
             raise w.error(key, str(err)) from None
         return {"shape": shape, **{k: dims[k] for k in ("ball_radius", "rod_diameter", "length")}}, mass, inertia
@@ -208,10 +207,9 @@ def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
     if "mass" in t and "density" in t:
         raise w.error(f"{key}.density", "give mass or density, not both")
     mass = _number(w, t, "mass", key, positive=True) if "mass" in t else _shape_mass(w, t, key, shape)
-    factor = {"disk": dims.get("radius", 0) ** 2 / 2, "ball": 0.4 * dims.get("radius", 0) ** 2,
-              "rectangle": (dims.get("width", 0) ** 2 + dims.get("height", 0) ** 2) / 12,
-              "rod": dims.get("length", 0) ** 2 / 12}[shape]
-    return {"shape": shape, **dims}, mass, mass * factor
+    inertia = {"disk": shapes.disk_inertia, "ball": shapes.ball_inertia, "rectangle": shapes.rectangle_inertia,
+               "rod": shapes.thin_rod_inertia}[shape](mass, *dims.values())
+    return {"shape": shape, **dims}, mass, inertia
 
 
 def _bodies(w, data) -> tuple[list, list, dict]:

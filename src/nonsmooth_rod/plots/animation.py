@@ -198,7 +198,7 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
     from matplotlib.figure import Figure
     from matplotlib.transforms import Affine2D
 
-    from ..rod.plotting import frame_indices
+    from .frames import frame_indices
 
     sf = sf or getattr(result, "scene_file", None)
     if sf is None:

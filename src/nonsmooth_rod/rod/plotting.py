@@ -19,6 +19,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..io import atomic_path, read_csv
+from ..plots.frames import frame_indices  # noqa: F401  (one frame picker for every animation)
 from .problem import RodProblem
 from ..results import Phase
 from .hypotheses import RollingHypothesis, rolling_hypothesis
@@ -343,15 +344,6 @@ def rod_outline(problem: RodProblem, x_O: float, theta: float, y_O: float | None
     c, s = math.cos(theta), math.sin(theta)
     return {"A": (x_O, y_O), "B": (x_O + problem.length * c, y_O + problem.length * s),
             "G": (x_O + problem.xi * c, y_O + problem.xi * s), "C": (x_O, y_O - problem.ball_radius)}
-
-
-def frame_indices(t, n_frames: int) -> np.ndarray:
-    """Samples nearest to n_frames evenly spaced times from the first to the last sample."""
-    t = np.asarray(t, float)
-    targets = np.linspace(t[0], t[-1], n_frames)
-    idx = np.array([int(np.argmin(np.abs(t - tt))) for tt in targets])
-    idx[-1] = len(t) - 1  # the very last state (after an impact, events repeat the time)
-    return idx
 
 
 def _draw_pose(ax, problem: RodProblem, x_O, theta, mode, *, trail=None, rod_gid="rod") -> None:

@@ -21,6 +21,7 @@ from ..validation import (
 from ..model.body import RigidBody
 from ..model.contacts import DiskOnLine, Line
 from ..model.laws import ContactLaw
+from ..model.shapes import rod_with_balls
 from ..model.scene import Scene
 
 PAPER_CASES = {1: (0.12, 0.10), 2: (0.28, 0.20), 3: (0.40, 0.30)}
@@ -58,15 +59,8 @@ class RodGeometry:
         solid spheres shifted by L/2 (Steiner). With the paper's data this gives
         M = 0.60436 kg, ξ = 0.205 m, J_Γ = 22.9838e-3 kg m² — the paper prints 22.983e-3.
         """
-        r, L, rho = self.ball_radius, self.length, self.density
-        m_ball = rho * 4.0 / 3.0 * math.pi * r**3
-        rod_len = L - 2 * r
-        rod_r = self.rod_diameter / 2
-        m_rod = rho * math.pi * rod_r**2 * rod_len
-        mass = 2 * m_ball + m_rod
-        xi = L / 2
-        inertia = 2 * (0.4 * m_ball * r**2 + m_ball * xi**2) + m_rod * (3 * rod_r**2 + rod_len**2) / 12
-        return mass, xi, inertia
+        mass, inertia = rod_with_balls(self.ball_radius, self.rod_diameter, self.length, self.density)
+        return mass, self.length / 2, inertia
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from ..model.body import RigidBody, cross2, rotate
 from ..model.contacts import Line, PointOnLine
 from ..model.laws import ContactLaw
 from ..model.scene import Scene
+from ..model.shapes import rectangle_inertia as _rectangle_inertia
 from ..results import SimulationResult
 from ..validation import InputError
 
@@ -33,10 +34,6 @@ def run(toy, method: str = "moreau-jean", t_end: float = 1.0, *, h: float = 1e-3
     else:
         raise InputError(f"unknown method '{method}'; choose moreau-jean or event-driven")
     return simulate(toy.scene(), q0, v0, t_end, method, **options)
-
-
-def _rectangle_inertia(mass: float, width: float, height: float) -> float:
-    return mass * (width**2 + height**2) / 12.0
 
 
 def _corners(body: int, width: float, height: float, line: Line, law: ContactLaw):
