@@ -168,7 +168,7 @@ def to_dataframe(result):
     try:
         import pandas as pd
     except ImportError:
-        raise InputError("to_dataframe needs pandas: pip install 'nonsmooth-rod[pandas]'") from None
+        raise InputError("to_dataframe needs pandas: pip install pandas") from None
     return pd.DataFrame(trajectory_columns(result))
 
 

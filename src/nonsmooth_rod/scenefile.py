@@ -109,7 +109,7 @@ def _number(w: _Where, table: dict, name: str, key: str, default=_REQUIRED, *, p
     full = f"{key}.{name}" if key else name
     if value is _REQUIRED:
         raise w.error(full, "missing (a number is required)")
-    if value is None:
+    if value is None and name not in table:  # an optional number left out
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise w.error(full, f"must be a number, got {value!r}")
@@ -212,16 +212,30 @@ def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
     return {"shape": shape, **dims}, mass, inertia
 
 
+def _finite_shape_of(w, t, key):
+    """_shape_of, refusing dimensions whose mass or inertia overflow a float."""
+    try:
+        shape, mass, inertia = _shape_of(w, t, key)
+    except OverflowError:
+        shape, mass, inertia = None, math.inf, math.inf
+    if not all(x is None or math.isfinite(x) for x in (mass, inertia)):
+        raise w.error(key, "the shape's mass or inertia overflows: dimensions or density far too large")
+    return shape, mass, inertia
+
+
 def _bodies(w, data) -> tuple[list, list, dict]:
     bodies, names, shapes = [], [], {}
     for name, t in _items(w, data, "bodies"):
         key = f"bodies.{name}"
         _check_keys(w, t, BODY_KEYS, key)
-        shape, mass, inertia = _shape_of(w, t, key)
+        shape, mass, inertia = _finite_shape_of(w, t, key)
         if "mass" in t or mass is None:
             mass = _number(w, t, "mass", key, positive=True)
         if "inertia" in t or inertia is None:
             inertia = _number(w, t, "inertia", key, positive=True)
+        for what, x in (("mass", mass), ("inertia", inertia)):
+            if x < 1e-300:  # 1/x would overflow
+                raise w.error(f"{key}.{what}" if what in t else key, f"the {what} {x:g} is too small to invert")
         bodies.append(RigidBody(mass, inertia, name=name))
         names.append(name)
         shapes[name] = shape
@@ -373,9 +387,14 @@ def _check_overlap(w, scene, q0, v0) -> None:
     tol = OVERLAP_TOLERANCE * _scene_size(scene)
     for c in scene.contacts:
         try:
-            gap = c.kinematics(q0, v0, scene.n_dof).gap
+            with np.errstate(all="ignore"):
+                kin = c.kinematics(q0, v0, scene.n_dof)
         except InputError as err:
             raise w.error(f"contacts.{c.name}", f"at the initial state: {err}") from None
+        gap = kin.gap
+        if not all(math.isfinite(x) for x in (gap, kin.drift_N, kin.drift_T)):
+            raise w.error("initial", f"contact {c.name!r}: the initial state overflows its kinematics "
+                                     "(positions or velocities far too large)")
         if gap < -tol:
             raise w.error("initial", f"contact {c.name!r} starts overlapping by {-gap:.6g} m "
                                      f"(tolerance {tol:.3g} m): move the bodies apart")
@@ -503,9 +522,12 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     contacts = _contacts(w, data, body_names, lines)
     forces = _forces(w, data, body_names)
     try:
-        scene = make_scene(bodies, contacts, gravity, forces)
+        with np.errstate(all="ignore"):
+            scene = make_scene(bodies, contacts, gravity, forces)
     except InputError as err:
         raise w.error("", str(err)) from None
+    if not np.all(np.isfinite(scene.weight)):
+        raise w.error("gravity", "the weight m g of a body overflows: masses or gravity far too large")
     q0, v0 = _initial(w, data, body_names)
     _check_overlap(w, scene, q0, v0)
     contact_names = [c.name for c in contacts]
