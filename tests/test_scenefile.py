@@ -136,6 +136,7 @@ BAD = [
     ("simulation.rtol", "1e-6", "simulation.rtol: unknown key"),
     ("simulation.solver", '"magic"', "simulation: unknown solver 'magic'"),
     ("simulation.stop", '"flor"', "simulation.stop: no contact named 'flor'"),
+    ("simulation.stop", '["floor", "floor"]', "simulation.stop: one contact at a time"),
     ("schema", '"nonsmooth-rod/scene/9"', "schema: must be 'nonsmooth-rod/scene/1'"),
     ("gravity", "inf", "gravity: must be finite"),
 ]

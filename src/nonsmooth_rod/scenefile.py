@@ -420,6 +420,8 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
     stop = [stop] if isinstance(stop, str) else stop
     if not isinstance(stop, list):
         raise w.error("simulation.stop", f"must be a contact name or a list of them, got {stop!r}")
+    if len(stop) > 1:
+        raise w.error("simulation.stop", f"one contact at a time (the first impact of it ends the run), got {stop!r}")
     for s in stop:
         _lookup(w, contact_names, s, "simulation.stop", "contact")
     cls = _options_class(method)
