@@ -256,3 +256,39 @@ def test_hostile_values_anywhere_are_refused_in_one_line_or_give_a_finite_scene(
                     assert "\n" not in str(err) and str(err).startswith("f.toml: "), (path, value)
                     continue
             assert np.all(np.isfinite(sf.scene.mass_diagonal)) and np.all(np.isfinite(sf.q0)), (path, value)
+
+
+def _pushed_block_with(force: dict, **law):
+    from nonsmooth_rod.scenefile import read_data
+
+    data, _ = read_data(SCENES / "pushed_block.toml")
+    data["forces"] = [{"name": "push", "body": "block", "point": [0.0, -0.025], **force}]
+    for contact in data["contacts"]:
+        contact["law"].update(law)
+    data["simulation"]["t_end"] = 0.3
+    return parse_scene(data)
+
+
+@pytest.mark.parametrize("force, position", [
+    # F = 10 N/s · t as a table: sticks until 0.4905 s > t_end, so the block stays put
+    ({"kind": "tabulated", "times": [0.0, 10.0], "forces": [[0.0, 0.0], [100.0, 0.0]]}, lambda t: 0 * t),
+    # 6 N > mu_s m g = 4.905 N from the start: slides at (F - mu_d m g)/m
+    ({"kind": "constant", "force": [6.0, 0.0]}, lambda t: 0.5 * (6.0 - 0.3 * 9.81) * t**2),
+])
+def test_forces_of_each_kind_give_the_closed_form_motion(force, position):
+    from nonsmooth_rod.scenefile import simulate_scene
+
+    result = simulate_scene(_pushed_block_with(force))
+    np.testing.assert_allclose(result.trajectory.q[:, 0], position(result.t), atol=1e-12)  # 1e-19 (table), 4e-16 m (constant) measured
+
+
+def test_a_damper_to_the_wall_slows_a_sliding_block_exponentially():
+    from nonsmooth_rod.scenefile import simulate_scene
+
+    sf = _pushed_block_with({"kind": "damper", "point_b": [-100.0, -0.0], "damping": 2.0}, mu_s=0.0, mu_d=0.0)
+    sf.v0[0] = 1.0
+    result = simulate_scene(sf)
+    # a long horizontal damper: ẍ = −(c/m) ẋ, ẋ = e^{−2t}. Moreau–Jean takes applied forces at the
+    # step's start velocity, first order: (1 − 2h)^k vs e^{−2kh}, relative 2 h t = 6e-4 at t = 0.3 s
+    np.testing.assert_allclose(result.trajectory.v[:, 0], np.exp(-2.0 * result.t), rtol=1e-3)
+    assert result.trajectory.v[-1, 0] < np.exp(-2.0 * result.t[-1])  # and on the damped side
