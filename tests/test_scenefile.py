@@ -3,6 +3,7 @@ overrides by name, and one-line errors naming the file and the key for every mal
 import copy
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,8 +13,6 @@ from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.scene_forces import build_force
 from nonsmooth_rod.scenefile import apply_override, load_scene, parse_scene
 from nonsmooth_rod.validation import InputError
-
-from pathlib import Path
 
 SCENES = Path(__file__).resolve().parents[1] / "examples" / "scenes"
 
@@ -90,7 +89,7 @@ def test_json_and_toml_read_the_same(tmp_path):
 
 def test_overrides_reach_entries_by_name():
     sf = load_scene(SCENES / "ladder.toml", ["contacts.foot.law.mu_s=0.2", "contacts.foot.law.mu_d=0.1",
-                                             "simulation.h=5e-4", "initial.ladder.v=[0.1, 0, 0]"])
+                                             "simulation.moreau-jean.h=5e-4", "initial.ladder.v=[0.1, 0, 0]"])
     foot = sf.scene.contacts[0]
     assert (foot.law.friction.mu_s, foot.law.friction.mu_d) == (0.2, 0.1)
     assert sf.options["h"] == 5e-4 and sf.v0[0] == 0.1
@@ -137,6 +136,8 @@ BAD = [
     ("simulation.solver", '"magic"', "simulation: unknown solver 'magic'"),
     ("simulation.stop", '"flor"', "simulation.stop: no contact named 'flor'"),
     ("simulation.stop", '["floor", "floor"]', "simulation.stop: one contact at a time"),
+    ("simulation.moreau-jean.h", "1e-4", "simulation.h: given twice: also as simulation.moreau-jean.h"),
+    ("simulation.event-driven.h", "1e-4", "simulation.event-driven.h: unknown key"),
     ("schema", '"nonsmooth-rod/scene/9"', "schema: must be 'nonsmooth-rod/scene/1'"),
     ("gravity", "inf", "gravity: must be finite"),
 ]

@@ -18,12 +18,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .integrators import METHODS
+from .model import shapes
 from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, Line
-from .model import shapes
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
-from .integrators import METHODS
 from .validation import InputError
 
 try:
@@ -416,28 +416,49 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
         raise w.error("simulation", f"must be a table, got {sim!r}")
     method = _text(w, sim, "method", "simulation", "moreau-jean", METHODS)
     t_end = _number(w, sim, "t_end", "simulation", positive=True)
+    stop = _stop(w, sim, contact_names)
+    options = _method_options(w, sim, method)
+    _check_options(w, _options_class(method), options, stop)
+    return method, t_end, options, stop
+
+
+def _stop(w, sim: dict, contact_names) -> list:
     stop = sim.get("stop", [])
     stop = [stop] if isinstance(stop, str) else stop
     if not isinstance(stop, list):
-        raise w.error("simulation.stop", f"must be a contact name or a list of them, got {stop!r}")
+        raise w.error("simulation.stop", f"must be a contact name, got {stop!r}")
     if len(stop) > 1:
         raise w.error("simulation.stop", f"one contact at a time (the first impact of it ends the run), got {stop!r}")
     for s in stop:
         _lookup(w, contact_names, s, "simulation.stop", "contact")
-    cls = _options_class(method)
-    allowed = [f.name for f in dataclasses.fields(cls) if f.name not in ("stop_at_impact",)]
-    options = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop")}
-    _check_keys(w, options, allowed, "simulation")
-    _check_options(w, cls, options, stop)
-    return method, t_end, options, stop
+    return stop
 
+
+def _allowed_options(method: str) -> list:
+    return [f.name for f in dataclasses.fields(_options_class(method)) if f.name != "stop_at_impact"]
+
+
+def _method_options(w, sim: dict, method: str) -> dict:
+    """Options of the chosen method: [simulation.<method>] over the flat keys of [simulation].
+    Tables of the other methods are checked for their key names only, so that
+    `--set simulation.method=event-driven` switches to options the file already holds."""
+    flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop") and k not in METHODS}
+    _check_keys(w, flat, _allowed_options(method) + list(METHODS), "simulation")
+    for name in METHODS:
+        if name in sim:
+            _check_keys(w, sim[name], _allowed_options(name), f"simulation.{name}")
+    own = sim.get(method, {})
+    for prefix, table in (("simulation", flat), (f"simulation.{method}", own)):
+        for key, value in table.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                raise w.error(f"{prefix}.{key}", f"must be finite, got {value!r}")
+            if prefix != "simulation" and key in flat:
+                raise w.error(f"simulation.{key}", f"given twice: also as {prefix}.{key}; keep one")
+    return {**flat, **own}
 
 
 def _check_options(w, cls, options: dict, stop: list) -> None:
     """Build the method's options once so a bad value is refused here, naming the key."""
-    for k, v in options.items():
-        if isinstance(v, float) and not math.isfinite(v):
-            raise w.error(f"simulation.{k}", f"must be finite, got {v!r}")
     try:
         cls(**options, stop_at_impact=stop[0] if stop else None)
     except InputError as err:

@@ -175,7 +175,7 @@ def test_save_load_round_trip_and_restart(tmp_path):
     (["run", "nope.toml"], "cannot read the scene file"),
     (["run", str(SCENES / "ladder.toml"), "--set", "contacts.foot.law.mu_d=0.9"], "contacts.foot.law.mu_d: 0.9 exceeds"),
     (["run", str(SCENES / "ladder.toml"), "--set", "contacts.knee.law.mu_s=1"], "no entry named 'knee'"),
-    (["run", str(SCENES / "ladder.toml"), "--set", "simulation.h=nan"], "simulation"),
+    (["run", str(SCENES / "ladder.toml"), "--set", "simulation.moreau-jean.h=nan"], "simulation.moreau-jean.h"),
     (["animate", "nowhere"], "no summary.json"),
     (["run", str(SCENES / "ladder.toml"), "--out", __file__], "--out"),
 ])
@@ -183,3 +183,12 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, fragment):
     assert main(args + (["--out", str(tmp_path)] if args[0] == "run" and "--out" not in args else [])) == 2
     captured = capsys.readouterr()
     assert fragment in captured.err and captured.err.count("\n") == 1 and "Traceback" not in captured.err
+
+
+def test_switching_method_by_set_takes_that_methods_own_options(tmp_path):
+    s, c = run(tmp_path, "ladder", "--set", "simulation.method=event-driven")
+    assert s["method"] == "event-driven" and s["options"]["rtol"] == 1e-10 and "h" not in s["options"]
+    mg, beta = 9.81, math.radians(60)
+    assert modes(s, "foot") == ["stick"]
+    assert c["foot.N"][-1] == pytest.approx(mg, rel=1e-9)
+    assert c["top.N"][-1] == pytest.approx(mg / (2 * math.tan(beta)), rel=1e-9)

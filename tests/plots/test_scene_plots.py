@@ -6,8 +6,14 @@ import numpy as np
 import pytest
 
 from nonsmooth_rod.cli import main
-from nonsmooth_rod.plots.animation import (animate, body_outline, body_size, build_animation, contact_frames,
-                                           write_animation)
+from nonsmooth_rod.plots.animation import (
+    animate,
+    body_outline,
+    body_size,
+    build_animation,
+    contact_frames,
+    write_animation,
+)
 from nonsmooth_rod.plots.scene_figure import plot_result, result_figure
 from nonsmooth_rod.scenefile import load_scene, simulate_scene
 

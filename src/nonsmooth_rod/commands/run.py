@@ -18,7 +18,8 @@ Simulate the scene described in a scene file (TOML or JSON, schema nonsmooth-rod
 see docs/scene-format.md). Writes trajectory.csv, summary.json, a copy of the scene file and
 figure.png into --out (docs/output-format.md); --animate adds animation.gif (and .mp4 where
 ffmpeg is installed). --set changes any value of the file by its dotted path, entries by name:
-  --set contacts.floor.law.mu_s=0.3 --set simulation.h=1e-4 --set initial.ball.v=[1,0,0]"""
+  --set contacts.floor.law.mu_s=0.3 --set simulation.method=event-driven
+  --set simulation.moreau-jean.h=1e-4 --set initial.ball.v=[1,0,0]"""
 
 
 def register(subparsers) -> None:
