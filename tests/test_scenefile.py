@@ -293,3 +293,15 @@ def test_a_damper_to_the_wall_slows_a_sliding_block_exponentially():
     # step's start velocity, first order: (1 − 2h)^k vs e^{−2kh}, relative 2 h t = 6e-4 at t = 0.3 s
     np.testing.assert_allclose(result.trajectory.v[:, 0], np.exp(-2.0 * result.t), rtol=1e-3)
     assert result.trajectory.v[-1, 0] < np.exp(-2.0 * result.t[-1])  # and on the damped side
+
+
+def test_the_docs_python_example_runs(monkeypatch):
+    import re
+
+    doc = SCENES.parents[1] / "docs" / "scene-format.md"
+    code, = re.findall(r"```python\n(.*?)```", doc.read_text(encoding="utf-8"), flags=re.S)
+    monkeypatch.chdir(SCENES.parents[1])
+    namespace = {}
+    exec(compile(code, str(doc), "exec"), namespace)
+    result = namespace["result"]
+    assert result.success and [p.mode for p in result.phases["foot"]] == ["slip+"]  # mu_s = 0.2 < cot 60° / 2
