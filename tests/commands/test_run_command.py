@@ -192,3 +192,12 @@ def test_switching_method_by_set_takes_that_methods_own_options(tmp_path):
     assert modes(s, "foot") == ["stick"]
     assert c["foot.N"][-1] == pytest.approx(mg, rel=1e-9)
     assert c["top.N"][-1] == pytest.approx(mg / (2 * math.tan(beta)), rel=1e-9)
+
+
+def test_restart_of_a_pushed_block_sees_the_push_at_absolute_time(tmp_path):
+    run(tmp_path, "pushed_block")
+    toy = toys.PushedBlock()
+    later = restart(tmp_path / "pushed_block", 0.6, t_end=1.0)
+    assert later.t[0] == pytest.approx(0.6, abs=1e-12) and later.t[-1] == pytest.approx(1.0, abs=1e-12)
+    # restarted from 0 the push would be 10 N/s · (t − 0.6) < μs m g: the block would stick again
+    np.testing.assert_allclose(later.trajectory.q[:, 0], toy.position(later.t), atol=H * toy.velocity(1.0))
