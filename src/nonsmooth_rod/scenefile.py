@@ -10,6 +10,7 @@ syntax `--set` takes: `contacts.floor.law.mu_d`) and what is wrong.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import math
 import re
@@ -308,13 +309,14 @@ def _force_fields(w, t, key, kind, body_names) -> dict:
     point = _vector(w, t, "point", key, 2, [0.0, 0.0])
     if kind in ("spring", "damper"):
         other = None if "body_b" not in t else _lookup(w, body_names, t["body_b"], f"{key}.body_b", "body")
-        fields = dict(body_a=body, point_a=point, body_b=other, point_b=_vector(w, t, "point_b", key, 2, [0.0, 0.0]),
-                      damping=_number(w, t, "damping", key, 0.0, nonnegative=True))
+        fields = {"body_a": body, "point_a": point, "body_b": other,
+                  "point_b": _vector(w, t, "point_b", key, 2, [0.0, 0.0]),
+                  "damping": _number(w, t, "damping", key, 0.0, nonnegative=True)}
         if kind == "spring":
             fields.update(stiffness=_number(w, t, "stiffness", key, nonnegative=True),
                           rest_length=_number(w, t, "rest_length", key, 0.0, nonnegative=True))
         return fields
-    fields = dict(body=body, point=point)
+    fields = {"body": body, "point": point}
     if kind == "tabulated":
         return {**fields, **_table_fields(w, t, key)}
     fields.update(force=_vector(w, t, "force", key, 2, [0.0, 0.0]), torque=_number(w, t, "torque", key, 0.0))
@@ -331,14 +333,14 @@ def _table_fields(w, t, key) -> dict:
         raise w.error(f"{key}.times", f"must be a list of times, got {times!r}")
     n = len(times)
     times = _vector(w, t, "times", key, n)
-    if any(b <= a for a, b in zip(times, times[1:])):
+    if any(b <= a for a, b in itertools.pairwise(times)):
         raise w.error(f"{key}.times", "must increase strictly")
     rows = t.get("forces")
     if not isinstance(rows, list) or len(rows) != n:
         raise w.error(f"{key}.forces", f"must be a list of {n} [fx, fy] pairs, one per time")
     forces = tuple(_vector(w, {"forces": r}, "forces", f"{key}", 2) for r in rows)
     torques = _vector(w, t, "torques", key, n) if "torques" in t else None
-    return dict(times=times, forces=forces, torques=torques)
+    return {"times": times, "forces": forces, "torques": torques}
 
 
 def _forces(w, data, body_names) -> list:

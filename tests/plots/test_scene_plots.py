@@ -34,7 +34,7 @@ def test_outlines_follow_the_declared_shapes():
     # the drawn balls sit exactly on the contacts' disks
     assert [(p[1], p[2]) for p in prims[1:]] == [(c.offset, c.radius) for c in sf.scene.contacts]
     block = load_scene(SCENES / "rocking_block.toml")
-    (kind, corners), = body_outline(block, 0)
+    (kind, _), = body_outline(block, 0)
     assert kind == "polygon" and body_size(block, 0) == pytest.approx(math.hypot(0.1, 0.3), rel=1e-15)
 
 
@@ -51,7 +51,7 @@ def test_a_body_without_shape_is_drawn_from_its_contacts():
 
 def test_contact_frames_are_the_touching_points(ladder_run):
     sf = ladder_run.scene_file
-    (foot, n_foot, t_foot), (top, n_top, _) = contact_frames(sf.scene, sf.q0)
+    (foot, _, _), (top, n_top, _) = contact_frames(sf.scene, sf.q0)
     np.testing.assert_allclose(foot, [1.0, 0.0], atol=1e-15)
     np.testing.assert_allclose(top, [0.0, 2 * math.sin(math.radians(60))], atol=1e-15)
     np.testing.assert_allclose(n_top, [1.0, 0.0], atol=1e-15)  # the wall pushes along +x
@@ -74,7 +74,7 @@ def test_animation_frames_move_the_bodies(ladder_run):
     ax = fig.axes[0]
     anim._func(3)
     patch = ax.patches[0] if ax.patches else None
-    line = [ln for ln in ax.lines if ln.get_transform() is not ax.transData][0]
+    line = next(ln for ln in ax.lines if ln.get_transform() is not ax.transData)
     q = ladder_run.trajectory.q[-1]
     # the rod's end (1, 0) in its frame lands on the top of the ladder in the world
     world = line.get_transform().transform([1.0, 0.0])
