@@ -140,6 +140,9 @@ BAD = [
     ("simulation.event-driven.h", "1e-4", "simulation.event-driven.h: unknown key"),
     ("schema", '"nonsmooth-rod/scene/9"', "schema: must be 'nonsmooth-rod/scene/1'"),
     ("gravity", "inf", "gravity: must be finite"),
+    ("title", "1979-05-27", "title: must be a number, string, list or table, got datetime.date"),
+    ("simulation.moreau-jean.solver_options", "{ when = 07:32:00 }",
+     "simulation.moreau-jean.solver_options.when: must be a number, string, list or table"),
 ]
 
 

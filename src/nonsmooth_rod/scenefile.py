@@ -534,13 +534,28 @@ def load_scene(path, overrides=()) -> SceneFile:
     return sf
 
 
+def _refuse_dates(w, node, key="") -> None:
+    """TOML dates and times have no place in a scene (and no JSON form for the summary)."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            _refuse_dates(w, v, f"{key}.{k}" if key else str(k))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            _refuse_dates(w, v, f"{key}[{i}]")
+    elif not (node is None or isinstance(node, (str, int, float, bool))):
+        raise w.error(key, f"must be a number, string, list or table, got {node!r}")
+
+
 def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     """The SceneFile of a scene's content (a dict as read from TOML or JSON)."""
     w = _Where(source)
     _check_keys(w, data, TOP_KEYS, "")
+    _refuse_dates(w, data)
     schema = data.get("schema")
     if schema != SCHEMA:
         raise w.error("schema", f"must be {SCHEMA!r} (this version reads that schema), got {schema!r}")
+    for key in ("title", "description"):
+        _text(w, data, key, "", "")
     gravity = _number(w, data, "gravity", "", 9.81, nonnegative=True)
     bodies, body_names, shapes = _bodies(w, data)
     lines = _lines(w, data)
