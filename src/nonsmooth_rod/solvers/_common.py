@@ -1,8 +1,11 @@
 """Small pieces shared by the solver modules (not public API)."""
 from __future__ import annotations
 
+import types
+
 import numpy as np
 
+from ..validation import InputError
 from .problem import ContactSolution, PlanarFrictionProblem, contact_states
 
 
@@ -55,3 +58,35 @@ def make_solution(
     p = np.asarray(p, dtype=float)
     u = np.asarray(u, dtype=float)
     return ContactSolution(p=p, u=u, solver=solver, iterations=iterations, residual=residual, info=info)
+
+
+def require_finite_array(name: str, values: np.ndarray, who: str = "") -> None:
+    """InputError naming the argument and the first NaN/inf entry, if there is one."""
+    if values.size and not np.isfinite(values).all():
+        index = np.unravel_index(int(np.flatnonzero(~np.isfinite(values))[0]), values.shape)
+        where = index[0] if len(index) == 1 else tuple(int(i) for i in index)
+        prefix = f"{who}: " if who else ""
+        raise InputError(f"{prefix}{name} must be finite, got {values[index]!r} at index {where}")
+
+
+_INTERPRETED: dict = {}
+
+
+def interpreted(function):
+    """The plain-Python twin of a `_jit.jit` kernel: its source run by the interpreter, and so
+    every compiled kernel it calls (their globals rebound to interpreted twins, recursively).
+    Without numba the kernels are plain functions already and come back unchanged. Lets
+    ``jit=False`` and the compiled-vs-interpreted tests run the one source both ways."""
+    python = getattr(function, "py_func", None)
+    if python is None:
+        return function
+    twin = _INTERPRETED.get(id(function))
+    if twin is None:
+        namespace = dict(python.__globals__)
+        twin = types.FunctionType(python.__code__, namespace, python.__name__, python.__defaults__,
+                                  python.__closure__)
+        _INTERPRETED[id(function)] = twin
+        for name, value in list(namespace.items()):
+            if getattr(value, "py_func", None) is not None and callable(value):
+                namespace[name] = interpreted(value)
+    return twin
