@@ -392,10 +392,12 @@ _lemke_kernel_jit = _lemke_kernel
 _lemke_friction_kernel_jit = _lemke_friction_kernel
 
 
-@jit
 def _default_max_pivots(n):
     # Lemke typically needs O(n) pivots; exponential worst cases do not occur at n ≤ 12.
     return 50 + 20 * n
+
+
+default_max_pivots = jit(_default_max_pivots)  # for the compiled callers
 
 
 def _variable_name(index: int, n: int) -> str:
