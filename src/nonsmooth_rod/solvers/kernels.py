@@ -7,8 +7,15 @@ the friction interval [lo_i p_N, hi_i p_N] of `problem.PlanarFrictionProblem`::
 
 fills p and u = W p + q in place (p is also pgs's warm start) and returns a status code,
 the solver's iterations (Lemke pivots, pgs sweeps, enum combinations) and the common
-complementarity residual. ``rtol`` is the acceptance tolerance relative to the problem's
-scale max(‖q‖∞, ‖p‖∞, ‖u‖∞); ``rtol ≤ 0`` or ``max_iter ≤ 0`` take the solver's default.
+complementarity residual. ``rtol`` is the tolerance on that residual relative to the
+problem's scale max(‖q‖∞, ‖p‖∞, ‖u‖∞); ``rtol ≤ 0`` takes the solver's default (Lemke and
+enum accept DEFAULT_RTOL; pgs aims for PGS_RTOL and accepts DEFAULT_RTOL once it stalls).
+``max_iter``: Lemke's pivot limit, pgs's sweep limit (≤ 0: their defaults); enum ignores it
+(all 4^na combinations up to enumeration.MAX_CONTACTS contacts, KERNEL_TOO_LARGE beyond).
+On any status but KERNEL_SOLVED, p = 0 and u = q (pgs leaves its last iterate).
+
+Large scenes: `pgs_block` on the block-sparse Delassus (indptr, indices, blocks; see
+`gauss_seidel.dense_to_blocks`) costs O(nonzero blocks) per sweep.
 
 Every function here is decorated with `nonsmooth_rod._jit.jit`: numba-compiled when numba is
 installed, the same source interpreted otherwise. Float64 arrays, int64 scalars only.
@@ -19,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit
+from .enumeration import enum_interval
 from .gauss_seidel import dense_to_blocks, pgs_block, pgs_dense
 from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_kernel
 
@@ -85,8 +93,9 @@ def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
         return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter)
     if solver_code == SOLVER_PGS:
         return pgs_dense(W, q, lo, hi, p, u, rtol, max_iter)
-    # enum: wired in the next commit
-    p[:] = 0.0
+    if solver_code == SOLVER_ENUM:
+        return enum_interval(W, q, lo, hi, p, u, rtol, 0)  # max_iter: no meaning for enum
+    p[:] = 0.0  # an unknown solver code: nothing solved
     u[:] = q
     return KERNEL_NO_CONVERGENCE, 0, np.inf
 
@@ -94,5 +103,5 @@ def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
 __all__ = [
     "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
     "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
-    "solve_interval", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "step_residual", "contact_residual", "problem_scale", "all_finite",
+    "solve_interval", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
 ]
