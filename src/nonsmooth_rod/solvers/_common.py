@@ -6,7 +6,7 @@ import types
 import numpy as np
 
 from ..validation import InputError
-from .problem import ContactSolution, PlanarFrictionProblem, contact_states
+from .problem import ContactSolution, PlanarFrictionProblem, _require_finite, contact_states
 
 
 def velocities_and_residual(W, q, lo, hi, p):
@@ -61,12 +61,11 @@ def make_solution(
 
 
 def require_finite_array(name: str, values: np.ndarray, who: str = "") -> None:
-    """InputError naming the argument and the first NaN/inf entry, if there is one."""
-    if values.size and not np.isfinite(values).all():
-        index = np.unravel_index(int(np.flatnonzero(~np.isfinite(values))[0]), values.shape)
-        where = index[0] if len(index) == 1 else tuple(int(i) for i in index)
-        prefix = f"{who}: " if who else ""
-        raise InputError(f"{prefix}{name} must be finite, got {values[index]!r} at index {where}")
+    """InputError naming the argument (and ``who`` refused it) at its first NaN/inf entry."""
+    try:
+        _require_finite(name, values)
+    except InputError as error:
+        raise InputError(f"{who}: {error}" if who else str(error)) from None
 
 
 _INTERPRETED: dict = {}

@@ -25,6 +25,7 @@ import numpy as np
 
 from .._jit import jit
 from ._common import RESIDUAL_FLOOR, make_solution
+from ..validation import InputError
 from .kernel_base import (
     KERNEL_NO_CONVERGENCE,
     KERNEL_NONFINITE,
@@ -300,7 +301,7 @@ def mode_solutions(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, r
 
 def _check_size(problem):
     if problem.n_contacts > MAX_CONTACTS:
-        raise ValueError(
+        raise InputError(
             f"enum: {problem.n_contacts} contacts exceed the enumeration limit of {MAX_CONTACTS}"
         )
 

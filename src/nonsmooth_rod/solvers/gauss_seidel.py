@@ -30,6 +30,7 @@ import numpy as np
 
 from .._jit import jit
 from ._common import make_solution, require_finite_array
+from ..validation import InputError
 from .kernel_base import (
     DEFAULT_RTOL,
     KERNEL_NO_CONVERGENCE,
@@ -236,7 +237,7 @@ def projected_gauss_seidel(
     n = 2 * problem.n_contacts
     p = np.zeros(n) if p0 is None else np.array(p0, dtype=float).ravel()
     if p.shape[0] != n:
-        raise ValueError(f"pgs: warm start has {p.shape[0]} entries, the problem has {n}")
+        raise InputError(f"pgs: warm start has {p.shape[0]} entries, the problem has {n}")
     require_finite_array("p0", p, "pgs")
     u = problem.q.copy()
     if n == 0:

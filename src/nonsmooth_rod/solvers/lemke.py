@@ -438,8 +438,8 @@ def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
 
 def run_lemke(M, q, max_pivots: int | None, jit: bool | None):
     """Validate (M, q), scale, pivot: (z, status, pivots, last entering, max_pivots used)."""
-    M = np.array(M, dtype=float, ndmin=2)
-    q = np.array(q, dtype=float, ndmin=1)
+    M = _float_array("M", M, 2)
+    q = _float_array("q", q, 1)
     n = q.shape[0]
     if q.ndim != 1 or M.shape != (n, n):
         raise InputError(f"lemke: M must be {n}×{n} for q of length {n}, got M {M.shape}, q {q.shape}")
@@ -447,6 +447,8 @@ def run_lemke(M, q, max_pivots: int | None, jit: bool | None):
     require_finite_array("q", q, "lemke")
     if max_pivots is None:
         max_pivots = _default_max_pivots(n)
+    if isinstance(max_pivots, bool) or not isinstance(max_pivots, (int, np.integer)) or max_pivots < 0:
+        raise InputError(f"lemke: max_pivots must be a non-negative integer, got {max_pivots!r}")
     m_scale = float(np.max(np.abs(M), initial=0.0)) or 1.0
     q_scale = float(np.max(np.abs(q), initial=0.0)) or 1.0
     kernel = _lemke_kernel if _use_jit(jit) else interpreted(_lemke_kernel)
@@ -454,11 +456,18 @@ def run_lemke(M, q, max_pivots: int | None, jit: bool | None):
     return np.asarray(z, dtype=float) * (q_scale / m_scale), status, pivots, entering, max_pivots
 
 
+def _float_array(name, values, ndmin):
+    try:
+        return np.array(values, dtype=float, ndmin=ndmin)
+    except (TypeError, ValueError):
+        raise InputError(f"lemke: {name} must be an array of numbers, got {values!r}") from None
+
+
 def _use_jit(jit: bool | None) -> bool:
     if jit is None:
         return HAVE_NUMBA
     if jit and not HAVE_NUMBA:
-        raise ValueError("jit=True needs numba, which is not installed")
+        raise InputError("jit=True needs numba, which is not installed")
     return jit
 
 
@@ -516,7 +525,7 @@ def lemke_friction(
     tol · residual_scale (round-off only, normally ~1e-15).
     """
     if formulation not in FORMULATIONS:
-        raise ValueError(f"lemke: unknown formulation {formulation!r}; choose from {sorted(FORMULATIONS)}")
+        raise InputError(f"lemke: unknown formulation {formulation!r}; choose from {sorted(FORMULATIONS)}")
     jit = _use_jit(jit)
     result = _attempt(problem, formulation, max_pivots, tol, jit)
     used = formulation
