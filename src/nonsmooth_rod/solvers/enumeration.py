@@ -278,6 +278,8 @@ def _solve_modes(problem, modes, rcond):
 
 def _candidates(problem: PlanarFrictionProblem, rcond: float):
     """(modes, P, U, residuals, scales) for every mode combination's solution."""
+    if not all(all_finite(getattr(problem, name)) for name in ("W", "q", "lo", "hi")):
+        raise InputError("enum: the problem's W, q, lo, hi must be finite")  # changed after it was made
     modes = _mode_table(problem.n_contacts)
     P, U, residuals, scales = enum_candidates(problem.W, problem.q, problem.lo, problem.hi, modes,
                                               float(rcond))

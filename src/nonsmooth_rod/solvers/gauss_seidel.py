@@ -245,6 +245,8 @@ def projected_gauss_seidel(
     rtol = 0.0 if tol is None else float(tol)
     status, sweeps, residual = pgs_dense(problem.W, problem.q, problem.lo, problem.hi, p, u, rtol,
                                          int(max_iter))
+    if status == KERNEL_NONFINITE:  # only if the problem's arrays were changed after it was made
+        raise InputError("pgs: the problem's W, q, lo, hi must be finite")
     if status != KERNEL_SOLVED:
         scale = max(np.abs(p).max(), np.abs(u).max(), np.abs(problem.q).max()) or 1.0
         raise NoConvergence(
