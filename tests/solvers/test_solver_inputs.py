@@ -64,3 +64,12 @@ def test_every_solver_still_solves_finite_data(name):
     problem = block_on_incline(0.6, 0.5)
     solution = solve(problem, name)
     assert np.all(np.isfinite(solution.p)) and solution.info["states"] == ["slip+", "slip+"]
+
+
+def test_problem_keeps_its_own_validated_copies():
+    data = corrupted("q", 0.0)
+    problem = PlanarFrictionProblem(**data)
+    data["q"][0] = np.nan  # the caller reuses its array: the problem is unaffected
+    assert np.all(np.isfinite(problem.q))
+    with pytest.raises(InputError, match="W must be an array of numbers"):
+        PlanarFrictionProblem("W", data["q"], data["lo"], data["hi"])

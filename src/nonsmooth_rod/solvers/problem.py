@@ -56,10 +56,12 @@ class PlanarFrictionProblem:
     hi: np.ndarray
 
     def __post_init__(self):
-        W = np.asarray(self.W, dtype=float)
-        q = np.asarray(self.q, dtype=float)
-        lo = np.atleast_1d(np.asarray(self.lo, dtype=float))
-        hi = np.atleast_1d(np.asarray(self.hi, dtype=float))
+        # Own copies: validated once here, they cannot turn non-finite behind the solvers'
+        # back when the caller reuses its arrays.
+        W = _float_array("W", self.W)
+        q = _float_array("q", self.q)
+        lo = np.atleast_1d(_float_array("lo", self.lo))
+        hi = np.atleast_1d(_float_array("hi", self.hi))
         n = q.shape[0] if q.ndim == 1 else -1
         if n % 2 or W.shape != (n, n) or lo.shape != (n // 2,) or hi.shape != (n // 2,):
             raise InputError(
@@ -83,6 +85,13 @@ class PlanarFrictionProblem:
         """The ordinary one-coefficient Coulomb problem |p_T| ≤ μ p_N."""
         mu = np.atleast_1d(np.asarray(mu, dtype=float))
         return cls(W, q, -mu, mu)
+
+
+def _float_array(name: str, values) -> np.ndarray:
+    try:
+        return np.array(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be an array of numbers, got {values!r}") from None
 
 
 def _require_finite(name: str, values: np.ndarray) -> None:
