@@ -52,6 +52,7 @@ from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit
 from ..validation import InputError
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
+from .kernel_base import step_residual
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -351,23 +352,7 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
                 p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
             else:
                 p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
-        # u = W p + q and complementarity_residual (same formula as problem.py).
-        for i in range(2 * n_c):
-            value = q[i]
-            W_i = W[i]
-            for j in range(2 * n_c):
-                value += W_i[j] * p[j]
-            u[i] = value
-        for i in range(n_c):
-            p_n = p[2 * i]
-            p_t = p[2 * i + 1]
-            r_n = abs(min(p_n, u[2 * i]))
-            p_n_pos = max(p_n, 0.0)
-            trial = p_t - u[2 * i + 1]
-            low = lo[i] * p_n_pos
-            high = hi[i] * p_n_pos
-            projected = low if trial < low else (high if trial > high else trial)
-            residual = max(residual, r_n, abs(p_t - projected))
+        residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
     norms = (q_norm, W_norm, max(q_norm, _max_abs(p), _max_abs(u)))
     if status == RAY:
         # Wedged contacts (two normals nearly opposed, W singular) make the solution set
