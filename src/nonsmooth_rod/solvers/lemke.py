@@ -141,6 +141,34 @@ def _lex_smaller(T, i, k, e, n):
 
 
 @jit
+def _first_leaving_row(T, n, rhs):
+    """Entering z0 drives w up by z0·d; the row that leaves is the lexicographic minimum of
+    (q_i, e_i): the most negative q_i, ties to the LARGEST index (e_i is lexicographically
+    smaller for larger i). −1 when q ≥ 0 (z = 0 solves the LCP)."""
+    r = -1
+    q_min = 0.0
+    for i in range(n):
+        value = T[i, rhs]
+        if value < 0.0:
+            if r < 0 or value <= q_min + TIE_TOL * (1.0 + abs(q_min)):
+                r = i
+                q_min = min(q_min, value)
+    return r
+
+
+@jit
+def _prefer_z0(T, r, z0_row, entering, rhs, pivot_tol):
+    """If z0 ties for leaving, let it leave: that ends the method with a solution."""
+    a0 = T[z0_row, entering]
+    if r != z0_row and a0 > pivot_tol:
+        ratio0 = T[z0_row, rhs] / a0
+        ratio = T[r, rhs] / T[r, entering]
+        if ratio0 <= ratio + TIE_TOL * (1.0 + abs(ratio)):
+            return z0_row
+    return r
+
+
+@jit
 def _complementary_pivoting(T, basis, n, max_pivots):
     """Lemke's method on tableau T = [I | −M | −d | q]; basis[i] is the variable of row i.
 
@@ -150,17 +178,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
     """
     z0 = 2 * n
     rhs = 2 * n + 1
-    # Entering z0 drives w up by z0·d; the row that leaves is the lexicographic minimum of
-    # (q_i, e_i): the most negative q_i, ties to the LARGEST index (e_i is lexicographically
-    # smaller for larger i).
-    r = -1
-    q_min = 0.0
-    for i in range(n):
-        value = T[i, rhs]
-        if value < 0.0:
-            if r < 0 or value <= q_min + TIE_TOL * (1.0 + abs(q_min)):
-                r = i
-                q_min = min(q_min, value)
+    r = _first_leaving_row(T, n, rhs)
     if r < 0:
         return SOLVED, 0, -1
     if max_pivots < 1:
@@ -187,13 +205,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
             if T[z0_row, rhs] <= ZERO_Z0_TOL:
                 return SOLVED, pivots, entering
             return RAY, pivots, entering
-        # If z0 ties for leaving, let it leave: that ends the method with a solution.
-        a0 = T[z0_row, entering]
-        if r != z0_row and a0 > pivot_tol:
-            ratio0 = T[z0_row, rhs] / a0
-            ratio = T[r, rhs] / T[r, entering]
-            if ratio0 <= ratio + TIE_TOL * (1.0 + abs(ratio)):
-                r = z0_row
+        r = _prefer_z0(T, r, z0_row, entering, rhs, pivot_tol)
         if pivots >= max_pivots:
             return PIVOT_LIMIT, pivots, entering
         _pivot(T, r, entering)
