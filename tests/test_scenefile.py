@@ -118,6 +118,8 @@ BAD = [
     ("bodies.ball.mass", '"heavy"', "bodies.ball.mass: must be a number"),
     ("bodies.ball.colour", '"red"', "bodies.ball.colour: unknown key"),
     ("bodies.ball.shape", '"cube"', "bodies.ball.shape: must be one of"),
+    ("bodies.ball.width", "0.1", "bodies.ball.width: not a dimension of a ball: it takes radius, density"),
+    ("bodies.ball.density", "7800", "bodies.ball.density: give mass or density, not both"),
     ("contacts.floor.body", '"bal"', "contacts.floor.body: no body named 'bal' (have: ball)"),
     ("contacts.floor.line", '"wall"', "contacts.floor.line: no line named 'wall'"),
     ("contacts.floor.kind", '"disk-on-cube"', "contacts.floor.kind: must be one of"),

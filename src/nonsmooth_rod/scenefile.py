@@ -191,9 +191,19 @@ def _shape_mass(w, t, key, shape) -> float:
     raise w.error(f"{key}.density", f"a {shape} takes its mass directly: give mass instead")
 
 
+SHAPE_KEYS = {None: (), "disk": ("radius", "density", "thickness"), "ball": ("radius", "density"),
+              "rectangle": ("width", "height", "density", "thickness"), "rod": ("length",),
+              "rod-with-balls": ("ball_radius", "rod_diameter", "length", "density")}
+
+
 def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
     """(drawing shape, mass, inertia) from `shape` and its dimensions; None where the shape gives none."""
     shape = _text(w, t, "shape", key, None, SHAPES) if "shape" in t else None
+    stray = [k for k in t if k in BODY_KEYS[4:] and k not in SHAPE_KEYS[shape]]
+    if stray:
+        takes = ", ".join(SHAPE_KEYS[shape]) or "no dimensions (give mass and inertia, or a shape)"
+        raise w.error(f"{key}.{stray[0]}", f"not a dimension of {'a ' + shape if shape else 'a body without shape'}: "
+                                           f"it takes {takes}")
     if shape is None:
         return {}, None, None
     if shape == "rod-with-balls":
