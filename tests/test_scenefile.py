@@ -173,6 +173,9 @@ def test_bad_values_are_one_line_naming_file_and_key(path, value, message):
                                  "forces": [[1, 0]]}]), "forces.tab.forces: must be a list of 2"),
     (lambda d: d.update(forces=[{"kind": "spring", "name": "s", "body": "ghost", "stiffness": 1}]),
      "forces.s.body: no body named 'ghost'"),
+    (lambda d: d.update(forces=[{"kind": "spring", "name": "s", "body": "ball", "body_b": "ball", "stiffness": 1}]),
+     "forces.s.body_b: joins a body to itself"),
+    (lambda d: d["contacts"][0].pop("line"), "contacts.floor.line: missing: name a line (have: ground)"),
 ])
 def test_bad_structure_is_one_line(edit, message):
     data = copy.deepcopy(BALL)

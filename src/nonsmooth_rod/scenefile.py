@@ -168,6 +168,8 @@ def _items(w: _Where, data: dict, section: str) -> list[tuple[str, dict]]:
 
 
 def _lookup(w: _Where, names: list, value, key: str, what: str) -> int:
+    if value is None:
+        raise w.error(key, f"missing: name a {what} (have: {', '.join(names) or 'none'})")
     if not isinstance(value, str):
         raise w.error(key, f"must be the name of a {what}, got {value!r}")
     if value not in names:
@@ -319,6 +321,8 @@ def _force_fields(w, t, key, kind, body_names) -> dict:
     point = _vector(w, t, "point", key, 2, [0.0, 0.0])
     if kind in ("spring", "damper"):
         other = None if "body_b" not in t else _lookup(w, body_names, t["body_b"], f"{key}.body_b", "body")
+        if other == body:
+            raise w.error(f"{key}.body_b", "joins a body to itself; leave body_b out to anchor point_b in the world")
         fields = {"body_a": body, "point_a": point, "body_b": other,
                   "point_b": _vector(w, t, "point_b", key, 2, [0.0, 0.0]),
                   "damping": _number(w, t, "damping", key, 0.0, nonnegative=True)}
