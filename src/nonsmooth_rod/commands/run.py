@@ -91,8 +91,7 @@ def cmd_run(args) -> int:
     scene_file = load_scene(args.scene, args.set)
     out_dir = writable_folder(args.out)
     result = simulate_scene(scene_file)
-    command = "nonsmooth-rod " + " ".join(sys.argv[1:]) if sys.argv[1:2] == ["run"] else None
-    summary = save(result, out_dir, command=command)
+    summary = save(result, out_dir)
     console = Console(soft_wrap=True, stderr=False)
     if not args.no_plot:
         from ..plots.scene_figure import plot_result
@@ -104,7 +103,7 @@ def cmd_run(args) -> int:
         notes = write_animation(result, out_dir)
         if not (args.quiet or args.json):
             for note in notes:
-                console.print(note)
+                console.print(escape(note))
     if args.json:
         sys.stdout.write(dumps_json(summary))
     elif not args.quiet:
