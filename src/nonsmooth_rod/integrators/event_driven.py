@@ -165,23 +165,59 @@ def _interior_extrema(coef) -> np.ndarray:
     return np.sort(r[(r > -1.0) & (r < 1.0)])
 
 
+def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
+    """Round-off level of each indicator near state y: a thousand ulps of the size of its terms."""
+    n = scene.n_dof
+    length = float(np.max(np.abs(y[:n]), initial=0.0))
+    speed = float(np.max(np.abs(y[n:]), initial=0.0))
+    force = _force_scale(scene, t, y[:n], y[n:])
+    start = (_indicator_values(scene, modes, indicators, t, y)
+             if any(ind.kind == "painleve" for ind in indicators) else None)
+    sizes = []
+    for j, ind in enumerate(indicators):
+        contact = scene.contacts[ind.contact]
+        if ind.kind == "touchdown":
+            sizes.append(length + contact.radius + float(np.max(np.abs(contact.line.point)))
+                         + float(np.max(np.abs(contact.offset))))
+        elif ind.kind == "slip-zero":
+            sizes.append(speed * (1.0 + length) + abs(contact.line.velocity))
+        elif ind.kind == "painleve":
+            sizes.append(abs(start[j]))
+        else:
+            sizes.append(force)
+    return 1e3 * _EPS * np.array(sizes)
+
+
 class _Watch:
     """The indicators of one mode, watched over whole steps of the dense output.
 
     Each indicator is multiplied by −direction, so that it is positive on the side it starts
-    on ("safe") and its event is the first fall to ≤ 0. At the segment start the value counts
-    as safe (a slip starts at zero slip velocity, a rebound at zero gap): an event there needs
-    the indicator to move out of the safe side at once.
+    on ("safe") and its event is the first fall to ≤ 0. A segment often starts with an
+    indicator at zero (a slip at zero slip velocity, a flight at zero gap, a contact at the
+    edge of its cone): until it first leaves its round-off band (`noise`), it counts as safe;
+    leaving the band on the wrong side is an event there.
     """
 
-    def __init__(self, scene, modes, indicators, t0):
+    def __init__(self, scene, modes, indicators, t0, y0):
         self.scene, self.modes, self.indicators, self.t0 = scene, list(modes), indicators, t0
         self.sign = -np.array([ind.direction for ind in indicators], dtype=float)
+        self.noise = _noise_levels(scene, modes, indicators, t0, y0)
+        self.band_exit = np.full(len(indicators), math.inf)  # when each first left its start band
         self.evaluations = 0
 
     def safe_values(self, t, dense) -> np.ndarray:
         self.evaluations += 1
         return self.sign * _indicator_values(self.scene, self.modes, self.indicators, t, dense(t))
+
+    def _start_band(self, j, ts, s):
+        """Count values safe (in place) from the segment start until the indicator leaves its band."""
+        for k in range(len(ts)):
+            if ts[k] >= self.band_exit[j]:
+                return
+            if ts[k] > self.t0 and abs(s[k]) > self.noise[j]:
+                self.band_exit[j] = ts[k]
+                return
+            s[k] = max(s[k], _TINY)
 
     def first_event(self, dense, a, b, depth=0):
         """(t, j): the first crossing in [a, b] and which indicator makes it; None if none."""
@@ -190,8 +226,8 @@ class _Watch:
         ts = a + 0.5 * (b - a) * (_CHEB_X + 1.0)
         ts[0], ts[-1] = a, b
         s = np.array([self.safe_values(t, dense) for t in ts])
-        if a == self.t0:
-            s[0] = np.maximum(s[0], _TINY)
+        for j in range(len(self.indicators)):
+            self._start_band(j, ts, s[:, j])
         coef = _CHEB_FIT @ s
         err = np.abs(coef[-1]) + np.abs(coef[-2]) + 64 * _EPS * np.max(np.abs(s), axis=0)
         can_bisect = depth < _MAX_BISECTIONS and (b - a) > 1e3 * _EPS * max(1.0, abs(b))
@@ -220,6 +256,7 @@ class _Watch:
             t_ext = ts[0] + 0.5 * (ts[-1] - ts[0]) * (x_ext + 1.0)
             nodes_t = [ts[0], *t_ext, ts[-1]]
             nodes_s = [s[0], *(self.safe_values(t, dense)[j] for t in t_ext), s[-1]]
+            self._start_band(j, nodes_t, nodes_s)
             self._refine_near_misses(j, nodes_t, nodes_s, dense, 1e-3 * np.ptp(s) + 10.0 * err)
         return self._first_fall(j, nodes_t, nodes_s, dense)
 
@@ -242,8 +279,8 @@ class _Watch:
 
                 def f(t):
                     return self.safe_values(t, dense)[j]
-                if lo == self.t0 and f(lo) <= 0.0:
-                    return lo  # counted safe at the start, it leaves the safe side at once
+                if nodes_s[k] == _TINY and f(lo) <= 0.0:
+                    return lo  # counted safe in its start band, it leaves it on the wrong side
                 if nodes_s[k + 1] == 0.0:
                     return hi
                 return brentq(f, lo, hi, xtol=4 * _EPS, rtol=4 * _EPS)
@@ -436,8 +473,8 @@ class EventDriven:
         """Integrate `modes` from the run's state, step by step, to the first event or t_end.
         Returns the event's (kind, contact), or None at t_end; leaves the run at the stop."""
         indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
-        watch = _Watch(scene, modes, indicators, run.t)
         y0 = np.concatenate([run.q, run.v])
+        watch = _Watch(scene, modes, indicators, run.t, y0)
         solver = self._solver(scene, modes, run.t, y0, t_end)
         hit = None
         try:
