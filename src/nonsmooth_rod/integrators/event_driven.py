@@ -491,7 +491,7 @@ class EventDriven:
         finally:
             run.nfev += int(solver.nfev)
             run.indicator_evaluations += watch.evaluations
-        run.close(t_stop, dense(t_stop) if hit is not None else solver.y.copy(), modes)
+        run.close(float(t_stop), dense(t_stop) if hit is not None else solver.y.copy(), modes)
         return None if hit is None else (indicators[hit[1]].kind, indicators[hit[1]].contact)
 
     def _sample(self, run, dense, a, b, modes):
@@ -509,7 +509,7 @@ class EventDriven:
         if not self._sliding_singular(scene, solver.t, solver.y, modes, run.t, y0):
             raise _Stop("failed", f"integration failed at t = {solver.t:.6g} s in modes {modes}: "
                                   f"{message}")
-        run.close(solver.t, solver.y.copy(), modes)
+        run.close(float(solver.t), solver.y.copy(), modes)
         raise _Stop("painleve", f"Painlevé configuration at t = {run.t:.12g} s: the sliding problem loses "
                                 "consistency (A → 0) with the normal force growing without bound; the run "
                                 "stops here")
@@ -575,7 +575,7 @@ class EventDriven:
         if ts.size:
             run.sample(ts, np.tile(y, (ts.size, 1)), modes, dyn)
         run.rest_from = run.t
-        run.close(t_end, y, modes, dyn)
+        run.close(float(t_end), y, modes, dyn)
         return True
 
     # ------------------------------------------------------------------ impacts
