@@ -50,7 +50,7 @@ from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_i
 from ..validation import InputError, require_positive
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
-MAX_SAMPLES = 50_000_000  # output samples a run may hold (~ 2 GB for one body)
+MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 
 
 @dataclass
@@ -436,9 +436,11 @@ class EventDriven:
                 raise InputError(f"contact {c.name}: body must be an index below {len(scene.bodies)}, "
                                  f"got {c.body!r}")
         n_samples = t_end / self.options.output_dt
-        if n_samples > MAX_SAMPLES:
-            raise InputError(f"output_dt = {self.options.output_dt!r} s asks for {n_samples:.3g} samples over "
-                             f"t_end = {t_end!r} s; use output_dt ≥ {t_end / MAX_SAMPLES:.3g} s")
+        per_sample = 8 * (1 + 3 * scene.n_dof + 3 * len(scene.contacts))  # t, q, v, a, N, T, mode refs
+        if n_samples * per_sample > MAX_OUTPUT_BYTES:
+            raise InputError(f"output_dt = {self.options.output_dt!r} s over t_end = {t_end!r} s asks for "
+                             f"{n_samples:.3g} samples ({n_samples * per_sample / 2**30:.3g} GiB); use "
+                             f"output_dt ≥ {t_end * per_sample / MAX_OUTPUT_BYTES:.3g} s")
         return _state_vector("q0", q0, scene.n_dof), _state_vector("v0", v0, scene.n_dof)
 
     def _loop(self, scene, run, modes, t_end, names):
