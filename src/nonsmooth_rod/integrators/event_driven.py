@@ -188,6 +188,20 @@ def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
     return 1e3 * _EPS * np.array(sizes)
 
 
+# Events at one instant (to round-off): a contact that leaves or meets the line goes first, so
+# that a cone closing with N → 0 is not taken for a break-away.
+_PRIORITY = {"liftoff": 0, "touchdown": 0}
+
+
+def _first_of(found, indicators):
+    """The event (t, j) to act on among the crossings `found` in one step."""
+    if not found:
+        return None
+    t_first = min(t for t, _ in found)
+    tie = 8 * _EPS * max(1.0, abs(t_first))
+    return min((_PRIORITY.get(indicators[j].kind, 1), t, j) for t, j in found if t - t_first <= tie)[1:]
+
+
 class _Watch:
     """The indicators of one mode, watched over whole steps of the dense output.
 
@@ -239,7 +253,7 @@ class _Watch:
                 return self.first_event(dense, a, mid, depth + 1) or self.first_event(dense, mid, b, depth + 1)
             if t_cross is not None:
                 found.append((t_cross, j))
-        return min(found) if found else None
+        return _first_of(found, self.indicators)
 
     def _scan(self, j, ts, s, coef, err, dense, can_bisect):
         """Where indicator j first falls to ≤ 0 within the step ts[0]..ts[-1]: a time, None, or
@@ -305,6 +319,7 @@ class _Run:
     indicator_evaluations: int = 0
     last_impact_t: float = -math.inf
     rest_from: float | None = None
+    instant: tuple = (math.nan, {})  # (t, forced modes) of the events at the current instant
 
     def sample(self, t, y, modes, dynamics=None):
         self.samples.append((np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(y).copy(),
@@ -534,11 +549,29 @@ class EventDriven:
             run.events.append(Event(t, "slip-zero", names[i], {"from": modes[i]}))
             # The slip velocity has just crossed zero: re-stick if μs holds, else reverse.
             forced[i] = ["stick", "slip+" if modes[i] == "slip-" else "slip-"]
-        elif kind == "touchdown" and self._touchdown(scene, run, modes, i, names):
-            return None
-        new_modes = self._decide(scene, t, run.q, run.v, forced)
+        elif kind == "touchdown":
+            run.instant = (math.nan, {})  # the impact changed the velocities: decide afresh
+            if self._touchdown(scene, run, modes, i, names):
+                return None
+        new_modes = self._decide_at_instant(scene, run, forced)
         if kind == "slip-zero":
             run.events[-1].detail["to"] = new_modes[i]
+        return new_modes
+
+    def _decide_at_instant(self, scene, run, forced):
+        """Events at one instant compose: the modes forced by earlier events at this t still hold
+        (two corners lifting off together must not take turns re-closing each other), unless
+        together they admit no consistent mode."""
+        t_prev, forced_prev = run.instant
+        merged = {**forced_prev, **forced} if abs(run.t - t_prev) <= 8 * _EPS * max(1.0, abs(run.t)) else forced
+        try:
+            new_modes = self._decide(scene, run.t, run.q, run.v, merged)
+        except _Stop:
+            if merged == forced:
+                raise
+            merged = forced
+            new_modes = self._decide(scene, run.t, run.q, run.v, forced)
+        run.instant = (run.t, merged)
         return new_modes
 
     def _touchdown(self, scene, run, modes, i, names) -> bool:
