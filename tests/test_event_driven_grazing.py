@@ -136,7 +136,7 @@ def test_a_lift_that_outweighs_gravity_for_a_millisecond_lifts_the_body_off(body
     def lift(t, q, v):
         return np.array([0.0, mass * G * (1.0 + eps - k * (t - t0) ** 2), 0.0])
     scene, q0 = body(lift, mass)
-    res = EventDriven(EventDrivenOptions(**options)).run(scene, q0, np.zeros(3), 0.2)
+    res = EventDriven(EventDrivenOptions(output_dt=0.02, **options)).run(scene, q0, np.zeros(3), 0.2)
     assert res.status == "ok"
     for contact in scene.contacts:
         liftoffs = [e.t for e in res.events if e.kind == "liftoff" and e.contact == contact.name]
