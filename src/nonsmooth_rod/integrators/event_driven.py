@@ -217,6 +217,7 @@ class _Watch:
         self.sign = -np.array([ind.direction for ind in indicators], dtype=float)
         self.noise = _noise_levels(scene, modes, indicators, t0, y0)
         self.band_exit = np.full(len(indicators), math.inf)  # when each first left its start band
+        self._cached = {}
         self.evaluations = 0
 
     def safe_values(self, t, dense) -> np.ndarray:
@@ -239,7 +240,8 @@ class _Watch:
             return None
         ts = a + 0.5 * (b - a) * (_CHEB_X + 1.0)
         ts[0], ts[-1] = a, b
-        s = np.array([self.safe_values(t, dense) for t in ts])
+        s = np.array([self._cached.get(t) if t in self._cached else self.safe_values(t, dense) for t in ts])
+        self._cached = {b: s[-1].copy()}  # the next step starts where this one ends
         for j in range(len(self.indicators)):
             self._start_band(j, ts, s[:, j])
         coef = _CHEB_FIT @ s
