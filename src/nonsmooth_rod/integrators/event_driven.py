@@ -161,8 +161,8 @@ def _interior_extrema(coef) -> np.ndarray:
     if len(d) < 2:
         return np.empty(0)
     r = chebyshev.chebroots(d)
-    r = r[np.abs(r.imag) <= 1e-9].real
-    return np.sort(r[(r > -1.0) & (r < 1.0)])
+    r = r[np.abs(r.imag) <= 1e-5].real  # a near-double root (two close extrema) may come out complex
+    return np.unique(r[(r > -1.0) & (r < 1.0)])
 
 
 def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
