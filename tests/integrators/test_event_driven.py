@@ -106,3 +106,47 @@ def test_pure_sliding_hypothesis_reverses_and_sticks_filippov_when_mu_d_exceeds_
     high = sliding_hypothesis(RodProblem.paper(None, mu_s=0.30, mu_d=0.30))
     # μd = 0.30 > T/N(0) = 0.263: neither slip direction is consistent at release.
     assert high.filippov and high.filippov[0][0] == 0.0
+
+
+def test_frictionless_slide_is_labelled_by_its_slip_velocity():
+    # μs = μd = 0: the rod slides left from release (v_C < 0 throughout) — slip−, not slip+.
+    p = RodProblem.paper(None, mu_s=0.0, mu_d=0.0)
+    run = simulate(p)
+    assert modes(run) == ["slip-"]
+    tab = run.table
+    v_c = p.slip_velocity(tab["x_O_dot"], tab["theta_dot"])
+    moving = tab["t"] > 0.0
+    assert moving.sum() > 100 and np.all(v_c[moving] < 0)
+    assert np.all(tab["mode"] == "slip-")
+
+
+def test_frictionless_block_slip_label_follows_a_reversing_push():
+    # A frictionless block on a floor pushed along it by F = F0 cos(2πt) at its base: from rest,
+    # v = F0 sin(2πt) / (2π m) — right on (0, ½), left on (½, 1). Each corner carries no
+    # friction yet slides one way, then the other, reversing exactly at t = ½.
+    from nonsmooth_rod.integrators.event_driven import EventDriven
+    from nonsmooth_rod.model.body import RigidBody
+    from nonsmooth_rod.model.contacts import PointOnLine
+    from nonsmooth_rod.model.laws import ContactLaw
+    from nonsmooth_rod.model.scene import Scene
+
+    mass, width, height, F0 = 2.0, 0.2, 0.1, 3.0
+
+    def push(t, q, v):
+        f = F0 * math.cos(2 * math.pi * t)
+        return np.array([f, 0.0, f * height / 2])  # at the base: no moment about the corners
+    law = ContactLaw.of(0.0, 0.0, 0.0)
+    corners = [PointOnLine(0, (-width / 2, -height / 2), law=law, name="left"),
+               PointOnLine(0, (width / 2, -height / 2), law=law, name="right")]
+    scene = Scene([RigidBody(mass, mass * (width**2 + height**2) / 12)], corners, applied_force=push)
+    res = EventDriven().run(scene, [0.0, height / 2, 0.0], np.zeros(3), 1.0)
+    assert res.status == "ok"
+    for name in ("left", "right"):
+        assert [ph.mode for ph in res.phases[name]] == ["slip+", "slip-"]
+        assert res.phases[name][0].t_end == pytest.approx(0.5, abs=1e-9)
+    traj = res.trajectory
+    assert np.allclose(traj.v[:, 0], F0 * np.sin(2 * math.pi * traj.t) / (2 * math.pi * mass), atol=1e-9)
+    inside = (traj.t > 1e-3) & (np.abs(traj.t - 0.5) > 1e-3) & (traj.t < 1.0)
+    expected = np.where(traj.t[inside] < 0.5, "slip+", "slip-")
+    assert np.all(traj.modes[inside, 0] == expected) and np.all(np.sign(traj.v[inside, 0]) == np.where(
+        expected == "slip+", 1.0, -1.0))

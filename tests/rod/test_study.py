@@ -62,8 +62,8 @@ def test_stability_files_say_why_a_run_is_wrong(quick):
     rows = [dict(zip(data, vals)) for vals in zip(*data.values())]
     wrong = {(r["method"], int(r["case"]), r["knob"]): r["reasons"] for r in rows if r["right"] == "False"}
     assert "creep at stick" in wrong[("regularized", 3, "epsilon=0.001")]
-    # The event-driven step is capped (max_step), so even rtol 1e-4 sees case 2's short
-    # break-away window (T/N > μs from 0.104 s to 0.21 s) instead of stepping over it.
+    # Event-driven watches each step's indicators whole (their interior extrema), so even rtol
+    # 1e-4 sees case 2's short break-away window (T/N > μs from 0.104 s to 0.21 s).
     assert not any(method == "event-driven" for method, _, _ in wrong)
     right = [r for r in rows if r["right"] == "True"]
     assert all(r["reasons"] == "" and r["finished"] == "True" for r in right)

@@ -1,20 +1,35 @@
 """Event-driven (hybrid) integration: smooth modes joined by located, refined events.
 
 Within a mode (each contact open, sticking or sliding) the scene is a smooth ODE integrated
-with a high-order method (DOP853, tight tolerances). Mode changes are located as roots of
-event functions on the dense output (scipy refines them to a few ulps of t):
+with a high-order method (DOP853, tight tolerances), one step at a time. Mode changes are the
+zero crossings of switching indicators, evaluated on each step's dense output:
 
-* sticking contact: T − μs N = 0 (rising) or T + μs N = 0 (falling) → slip against it;
-* sliding contact: slip velocity = 0 → re-stick if the sticking solution has |T| ≤ μs N,
+* sticking contact: T − μs N rises through 0, or T + μs N falls through 0 → slip against it;
+* sliding contact: slip velocity crosses 0 → re-stick if the sticking solution has |T| ≤ μs N,
   else slip the other way (the re-stick test the paper's treatment misses);
-  and A = H_N M⁻¹ (H_N − s μd H_T) → 0: Painlevé, stop with status "painleve";
-* closed contact: N = 0 (falling) → contact opens (flight);
-* open contact: gap = 0 (falling) → impact, solved at impulse level with Newton restitution
+  and det A (A = H_N M⁻¹ (H_N − s μd H_T)) falls to 0: Painlevé, stop with status "painleve";
+* closed contact: N falls through 0 → contact opens (flight);
+* open contact: gap falls through 0 → impact, solved at impulse level with Newton restitution
   and two-coefficient Coulomb friction on the impulses (see onestep.py).
+
+A reference must never miss an event, so sign changes between steps are not enough: an
+indicator may cross and come back within one step (T/N above μs for microseconds near its
+maximum, a gap closing and reopening, N dipping below 0). Each accepted step is therefore
+watched whole (`_Watch`): every indicator is interpolated on Chebyshev points of the step's
+dense output, its interior extrema (roots of the interpolant's derivative) are evaluated
+exactly, an extremum that nearly reaches zero is refined by a bounded minimisation, and the
+first crossing is located with brentq on the dense output to a few ulps. A step whose
+indicators the interpolant cannot resolve is bisected. The step cap (`max_step`) is not
+needed for events and is off by default.
 
 The choice of modes at a switch enumerates the candidate modes of the contacts that are
 "at a decision" and keeps the first consistent one, preferring stick (a contact that μs can
-hold is held: this is what makes the paper's bistable start roll).
+hold is held: this is what makes the paper's bistable start roll). A sliding contact is
+labelled by the sign of its slip velocity, frictionless or not.
+
+A state at rest (v = 0 and a = 0 with constant forces: no applied force) stays at rest, so
+the run jumps to t_end at once (stats["rest_from"]); with an applied force it is integrated,
+and the step grows freely.
 """
 from __future__ import annotations
 
@@ -24,13 +39,18 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
+import scipy.integrate
+from numpy.polynomial import chebyshev
+from scipy.optimize import brentq, minimize_scalar
 
 from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import InputError, require_positive
+
+ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 
 
 @dataclass
@@ -41,9 +61,9 @@ class EventDrivenOptions:
     atol: float = 1e-12
     method: str = "DOP853"
     output_dt: float = 1e-3  # spacing of the saved samples (events are always saved)
-    # Events are seen as sign changes between steps: a loose tolerance lets DOP853 step clean
-    # over a short excursion (case 2's T/N > μs lasts 0.1 s) and miss it. Cap the step.
-    max_step: float = 1e-2
+    # Events are found within each step, whatever its length (see `_Watch`): the cap only
+    # bounds the step for whoever wants it; infinity (the default) leaves it to the tolerance.
+    max_step: float = math.inf
     stop_at_impact: str | None = None  # name of a contact whose first impact ends the run
     max_events: int = 10_000
     zeno_interval: float = 1e-9  # impacts closer than this in time: an accumulation point
@@ -55,8 +75,10 @@ class EventDrivenOptions:
         require_positive("rtol", self.rtol)
         require_positive("atol", self.atol)
         require_positive("output_dt", self.output_dt)
+        if self.method not in ODE_METHODS:
+            raise InputError(f"method must be one of {', '.join(ODE_METHODS)}, got {self.method!r}")
         if not (isinstance(self.max_step, (int, float)) and self.max_step > 0):  # inf: no cap
-            raise InputError(f"max_step must be positive, got {self.max_step!r}")
+            raise InputError(f"max_step must be positive (inf: no cap), got {self.max_step!r}")
 
 
 class _Stop(Exception):
@@ -66,11 +88,269 @@ class _Stop(Exception):
         self.detail = detail or {}
 
 
+# ---------------------------------------------------------------------- switching indicators
+@dataclass(frozen=True)
+class _Indicator:
+    """A switching function of the current mode: the event `kind` of `contact` happens where its
+    value crosses zero in `direction` (+1 rising, −1 falling)."""
+
+    kind: str  # touchdown, liftoff, break-upper, break-lower, slip-zero, painleve
+    contact: int
+    direction: int
+    offset: float = 0.0  # subtracted from the value
+
+
+def _indicators(scene, modes, force_tol: float) -> list[_Indicator]:
+    """The indicators that can end a segment in `modes`."""
+    out = []
+    for i, mode in enumerate(modes):
+        law = scene.contacts[i].law.friction
+        if mode == "open":
+            out.append(_Indicator("touchdown", i, -1))
+            continue
+        out.append(_Indicator("liftoff", i, -1))
+        if mode == "stick":
+            # A frictionless contact holds only with T = 0, known to round-off: it breaks away
+            # when it would need a tangential force beyond the force tolerance.
+            margin = force_tol if law.mu_s == 0.0 else 0.0
+            out.append(_Indicator("break-upper", i, +1, margin))
+            out.append(_Indicator("break-lower", i, -1, -margin))
+        else:
+            # Only the crossing back through zero counts, not the start of the slip at zero.
+            out.append(_Indicator("slip-zero", i, -1 if mode == "slip+" else +1))
+            if law.mu_d > 0.0:
+                out.append(_Indicator("painleve", i, -1))
+    return out
+
+
+def _indicator_values(scene, modes, indicators, t, y) -> np.ndarray:
+    """Values of the indicators at state y (the mode's dynamics are solved once, if needed)."""
+    n = scene.n_dof
+    q, v = y[:n], y[n:]
+    kin = scene.kinematics(q, v)
+    dyn = None
+    out = np.empty(len(indicators))
+    for j, ind in enumerate(indicators):
+        k = kin[ind.contact]
+        if ind.kind == "touchdown":
+            value = k.gap
+        elif ind.kind == "slip-zero":
+            value = k.H_T @ v - k.surface_velocity
+        else:
+            if dyn is None:
+                dyn = mode_dynamics(scene, t, q, v, modes, kin)
+            N, T = dyn.normal_force[ind.contact], dyn.tangential_force[ind.contact]
+            mu_s = scene.contacts[ind.contact].law.friction.mu_s
+            value = {"liftoff": N, "break-upper": T - mu_s * N, "break-lower": T + mu_s * N,
+                     "painleve": np.linalg.det(dyn.matrix) if dyn.matrix.size else 1.0}[ind.kind]
+        out[j] = value - ind.offset
+    return out
+
+
+_NODES = 13
+_CHEB_X = -np.cos(np.pi * np.arange(_NODES) / (_NODES - 1))  # Chebyshev–Lobatto points, ascending
+_CHEB_FIT = np.linalg.inv(chebyshev.chebvander(_CHEB_X, _NODES - 1))  # values → coefficients
+_MAX_BISECTIONS = 4
+_EPS = float(np.finfo(float).eps)
+_TINY = 5e-324  # a start value counted as just on the safe side
+
+
+def _interior_extrema(coef) -> np.ndarray:
+    """Points of (−1, 1) where the Chebyshev series `coef` has a local extremum, ascending."""
+    d = chebyshev.chebtrim(chebyshev.chebder(coef), tol=1e-14 * float(np.max(np.abs(coef))))
+    if len(d) < 2:
+        return np.empty(0)
+    r = chebyshev.chebroots(d)
+    r = r[np.abs(r.imag) <= 1e-5].real  # a near-double root (two close extrema) may come out complex
+    return np.unique(r[(r > -1.0) & (r < 1.0)])
+
+
+def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
+    """Round-off level of each indicator near state y: a thousand ulps of the size of its terms."""
+    n = scene.n_dof
+    length = float(np.max(np.abs(y[:n]), initial=0.0))
+    speed = float(np.max(np.abs(y[n:]), initial=0.0))
+    force = _force_scale(scene, t, y[:n], y[n:])
+    start = (_indicator_values(scene, modes, indicators, t, y)
+             if any(ind.kind == "painleve" for ind in indicators) else None)
+    sizes = []
+    for j, ind in enumerate(indicators):
+        contact = scene.contacts[ind.contact]
+        if ind.kind == "touchdown":
+            sizes.append(length + contact.radius + float(np.max(np.abs(contact.line.point)))
+                         + float(np.max(np.abs(contact.offset))))
+        elif ind.kind == "slip-zero":
+            sizes.append(speed * (1.0 + length) + abs(contact.line.velocity))
+        elif ind.kind == "painleve":
+            sizes.append(abs(start[j]))
+        else:
+            sizes.append(force)
+    return 1e3 * _EPS * np.array(sizes)
+
+
+# Events at one instant (to round-off): a contact that leaves or meets the line goes first, so
+# that a cone closing with N → 0 is not taken for a break-away.
+_PRIORITY = {"liftoff": 0, "touchdown": 0}
+
+
+def _first_of(found, indicators):
+    """The event (t, j) to act on among the crossings `found` in one step."""
+    if not found:
+        return None
+    t_first = min(t for t, _ in found)
+    tie = 8 * _EPS * max(1.0, abs(t_first))
+    return min((_PRIORITY.get(indicators[j].kind, 1), t, j) for t, j in found if t - t_first <= tie)[1:]
+
+
+class _Watch:
+    """The indicators of one mode, watched over whole steps of the dense output.
+
+    Each indicator is multiplied by −direction, so that it is positive on the side it starts
+    on ("safe") and its event is the first fall to ≤ 0. A segment often starts with an
+    indicator at zero (a slip at zero slip velocity, a flight at zero gap, a contact at the
+    edge of its cone): until it first leaves its round-off band (`noise`), it counts as safe;
+    leaving the band on the wrong side is an event there.
+    """
+
+    def __init__(self, scene, modes, indicators, t0, y0):
+        self.scene, self.modes, self.indicators, self.t0 = scene, list(modes), indicators, t0
+        self.sign = -np.array([ind.direction for ind in indicators], dtype=float)
+        self.noise = _noise_levels(scene, modes, indicators, t0, y0)
+        self.band_exit = np.full(len(indicators), math.inf)  # when each first left its start band
+        self._cached = {}
+        self.evaluations = 0
+
+    def safe_values(self, t, dense) -> np.ndarray:
+        self.evaluations += 1
+        return self.sign * _indicator_values(self.scene, self.modes, self.indicators, t, dense(t))
+
+    def _start_band(self, j, ts, s):
+        """Count values safe (in place) from the segment start until the indicator leaves its band."""
+        for k in range(len(ts)):
+            if ts[k] >= self.band_exit[j]:
+                return
+            if ts[k] > self.t0 and abs(s[k]) > self.noise[j]:
+                self.band_exit[j] = ts[k]
+                return
+            s[k] = max(s[k], _TINY)
+
+    def first_event(self, dense, a, b, depth=0):
+        """(t, j): the first crossing in [a, b] and which indicator makes it; None if none."""
+        if not self.indicators or b <= a:
+            return None
+        ts = a + 0.5 * (b - a) * (_CHEB_X + 1.0)
+        ts[0], ts[-1] = a, b
+        s = np.array([self._cached.get(t) if t in self._cached else self.safe_values(t, dense) for t in ts])
+        self._cached = {b: s[-1].copy()}  # the next step starts where this one ends
+        for j in range(len(self.indicators)):
+            self._start_band(j, ts, s[:, j])
+        coef = _CHEB_FIT @ s
+        err = np.abs(coef[-1]) + np.abs(coef[-2]) + 64 * _EPS * np.max(np.abs(s), axis=0)
+        can_bisect = depth < _MAX_BISECTIONS and (b - a) > 1e3 * _EPS * max(1.0, abs(b))
+        found = []
+        for j in range(len(self.indicators)):
+            t_cross = self._scan(j, ts, s[:, j], coef[:, j], err[j], dense, can_bisect)
+            if t_cross == "unresolved":
+                mid = 0.5 * (a + b)
+                return self.first_event(dense, a, mid, depth + 1) or self.first_event(dense, mid, b, depth + 1)
+            if t_cross is not None:
+                found.append((t_cross, j))
+        return _first_of(found, self.indicators)
+
+    def _scan(self, j, ts, s, coef, err, dense, can_bisect):
+        """Where indicator j first falls to ≤ 0 within the step ts[0]..ts[-1]: a time, None, or
+        "unresolved" when the interpolant cannot tell and the step should be halved."""
+        x_ext = _interior_extrema(coef)
+        p_ext = chebyshev.chebval(x_ext, coef)
+        if min(s[0], s[-1], *p_ext) > err:
+            return None  # on the safe side throughout, by more than the interpolation error
+        if err > 1e-3 * np.ptp(s):
+            if can_bisect:
+                return "unresolved"
+            nodes_t, nodes_s = list(ts), list(s)  # the samples themselves, at the finest halving
+        else:
+            t_ext = ts[0] + 0.5 * (ts[-1] - ts[0]) * (x_ext + 1.0)
+            nodes_t = [ts[0], *t_ext, ts[-1]]
+            nodes_s = [s[0], *(self.safe_values(t, dense)[j] for t in t_ext), s[-1]]
+            self._start_band(j, nodes_t, nodes_s)
+            self._refine_near_misses(j, nodes_t, nodes_s, dense, 1e-3 * np.ptp(s) + 10.0 * err)
+        return self._first_fall(j, nodes_t, nodes_s, dense)
+
+    def _refine_near_misses(self, j, nodes_t, nodes_s, dense, near):
+        """A local minimum just above zero may hide a crossing if the interpolant placed it a
+        little off: minimise the indicator itself between the neighbouring nodes."""
+        for k in range(1, len(nodes_t) - 1):
+            if 0.0 < nodes_s[k] <= near and nodes_s[k] < min(nodes_s[k - 1], nodes_s[k + 1]):
+                res = minimize_scalar(lambda t: self.safe_values(t, dense)[j], method="bounded",
+                                      bounds=(nodes_t[k - 1], nodes_t[k + 1]),
+                                      options={"xatol": 4 * _EPS * max(1.0, abs(nodes_t[k]))})
+                if res.fun < nodes_s[k]:
+                    nodes_t[k], nodes_s[k] = float(res.x), float(res.fun)
+
+    def _first_fall(self, j, nodes_t, nodes_s, dense):
+        """The first root where the indicator, monotone between nodes, falls to ≤ 0."""
+        for k in range(len(nodes_t) - 1):
+            if nodes_s[k] > 0.0 >= nodes_s[k + 1]:
+                lo, hi = nodes_t[k], nodes_t[k + 1]
+
+                def f(t):
+                    return self.safe_values(t, dense)[j]
+                if nodes_s[k] == _TINY and f(lo) <= 0.0:
+                    return lo  # counted safe in its start band, it leaves it on the wrong side
+                if nodes_s[k + 1] == 0.0:
+                    return hi
+                return brentq(f, lo, hi, xtol=4 * _EPS, rtol=4 * _EPS)
+        return None
+
+
+# ---------------------------------------------------------------------- the run's record
 @dataclass
-class _Segment:
-    t: list = field(default_factory=list)
-    y: list = field(default_factory=list)
-    modes: list = field(default_factory=list)
+class _Run:
+    """The current state of a run and everything it reports."""
+
+    t: float
+    q: np.ndarray
+    v: np.ndarray
+    events: list = field(default_factory=list)
+    impacts: list = field(default_factory=list)
+    samples: list = field(default_factory=list)  # blocks (t, y, modes, ModeDynamics or None)
+    boundaries: list = field(default_factory=lambda: [0.0])
+    interval_modes: list = field(default_factory=list)
+    steps: int = 0
+    nfev: int = 0
+    indicator_evaluations: int = 0
+    last_impact_t: float = -math.inf
+    rest_from: float | None = None
+    instant: tuple = (math.nan, {})  # (t, forced modes) of the events at the current instant
+
+    def sample(self, t, y, modes, dynamics=None):
+        self.samples.append((np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(y).copy(),
+                             list(modes), dynamics))
+
+    def close(self, t, y, modes, dynamics=None):
+        """End the current segment at t in state y (sampled there)."""
+        self.sample(t, y, modes, dynamics)
+        if t > self.boundaries[-1]:
+            self.boundaries.append(t)
+            self.interval_modes.append(list(modes))
+        n = len(y) // 2
+        self.t, self.q, self.v = t, np.array(y[:n], dtype=float), np.array(y[n:], dtype=float)
+
+
+def _force_scale(scene, t, q, v) -> float:
+    return max(1e-12, float(np.max(np.abs(scene.force(t, q, v)))))
+
+
+def _state_vector(name, value, n) -> np.ndarray:
+    try:
+        x = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a vector of {n} numbers, got {value!r}") from None
+    if x.shape != (n,):
+        raise InputError(f"{name} must have {n} entries (x, y, θ of each body), got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise InputError(f"{name} must be finite, got {x.tolist()}")
+    return x
 
 
 class EventDriven:
@@ -81,7 +361,7 @@ class EventDriven:
     def __init__(self, options: EventDrivenOptions | None = None):
         self.options = options or EventDrivenOptions()
 
-    # ------------------------------------------------------------------ helpers
+    # ------------------------------------------------------------------ mode decisions
     def _local(self, scene, q, v):
         kin = scene.kinematics(q, v)
         u_N = np.array([k.H_N @ v for k in kin])
@@ -94,7 +374,7 @@ class EventDriven:
         dyn = mode_dynamics(scene, t, q, v, modes, kin)
         if not np.all(np.isfinite(dyn.a)):
             return None
-        fscale = max(1e-12, float(np.max(np.abs(scene.force(t, q, v)))))
+        fscale = _force_scale(scene, t, q, v)
         ascale = max(1e-12, float(np.max(np.abs(dyn.a * scene.mass_diagonal))) / fscale)
         tolF = 1e-9 * fscale
         for i, mode in enumerate(modes):
@@ -123,7 +403,9 @@ class EventDriven:
 
     def _decide(self, scene, t, q, v, forced=None):
         """Modes after a switch: contacts in `forced` take one of the listed modes, the other
-        contacts at a decision (closed, at rest normally) are enumerated; stick first."""
+        contacts at a decision (closed, at rest normally) are enumerated; stick first. A contact
+        without friction is enumerated alike: it sticks only where it needs no tangential force,
+        and slides the way its slip velocity goes."""
         forced = forced or {}
         kin, gaps, u_N, u_T = self._local(scene, q, v)
         vt = self.options.velocity_tol
@@ -139,102 +421,199 @@ class EventDriven:
                 candidates.append(["slip+" if u_T[i] > 0 else "slip-", "open"])
                 decided.append(True)
             else:
-                order = ["stick", "slip+", "slip-", "open"]
-                if scene.contacts[i].law.friction.mu_s == 0.0:
-                    order = ["slip+", "open"]  # frictionless: no tangential force either way
-                candidates.append(order)
+                candidates.append(["stick", "slip+", "slip-", "open"])
                 decided.append(True)
         for modes in itertools.product(*candidates):
-            modes = list(modes)
-            # A frictionless contact at rest tangentially "slides" with zero force.
-            if self._consistent(scene, t, q, v, modes, kin, u_T,
-                                [d and not (m == "slip+" and scene.contacts[i].law.friction.mu_s == 0.0)
-                                 for i, (d, m) in enumerate(zip(decided, modes))]) is not None:
-                return modes
+            if self._consistent(scene, t, q, v, list(modes), kin, u_T, decided) is not None:
+                return list(modes)
         raise _Stop("painleve",
                     f"no consistent contact mode at t = {t:.12g} s (modes tried from {candidates}): "
                     "the sliding problem has no solution here (Painlevé-type inconsistency)")
+    # ------------------------------------------------------------------ main loop
+    def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
+        q, v = self._check_inputs(scene, q0, v0, t_end)
+        wall = time.process_time()
+        names = [c.name for c in scene.contacts]
+        run = _Run(0.0, q, v)
+        try:
+            modes = self._decide(scene, 0.0, q, v)
+            run.events.append(Event(0.0, "start", "", {"modes": list(modes)}))
+            status, message = self._loop(scene, run, modes, t_end, names)
+        except _Stop as stop:
+            status, message = stop.status, stop.message
+            run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
+        return self._result(scene, run, names, status, message, time.process_time() - wall)
 
-    def _event_functions(self, scene, modes, q0=None, v0=None):
-        """Event functions of the current mode, with what each one means."""
-        funcs, meanings = [], []
-        opts = self.options
-        n_dof = scene.n_dof
-        start_gaps = ([k.gap for k in scene.kinematics(q0, v0)] if q0 is not None
-                      else [math.inf] * len(modes))
+    def _check_inputs(self, scene, q0, v0, t_end):
+        require_positive("t_end", t_end)
+        for c in scene.contacts:
+            if not hasattr(c, "line"):
+                raise InputError("the event-driven integrator handles disk/point-on-line contacts only")
+            if not (isinstance(c.body, (int, np.integer)) and 0 <= c.body < len(scene.bodies)):
+                raise InputError(f"contact {c.name}: body must be an index below {len(scene.bodies)}, "
+                                 f"got {c.body!r}")
+        n_samples = t_end / self.options.output_dt
+        per_sample = 8 * (1 + 3 * scene.n_dof + 3 * len(scene.contacts))  # t, q, v, a, N, T, mode refs
+        if n_samples * per_sample > MAX_OUTPUT_BYTES:
+            raise InputError(f"output_dt = {self.options.output_dt!r} s over t_end = {t_end!r} s asks for "
+                             f"{n_samples:.3g} samples ({n_samples * per_sample / 2**30:.3g} GiB); use "
+                             f"output_dt ≥ {t_end * per_sample / MAX_OUTPUT_BYTES:.3g} s")
+        return _state_vector("q0", q0, scene.n_dof), _state_vector("v0", v0, scene.n_dof)
 
-        def split(y):
-            return y[:n_dof], y[n_dof:]
+    def _loop(self, scene, run, modes, t_end, names):
+        """Segments and switches until t_end (or a stop); returns (status, message)."""
+        n_events = 0
+        while run.t < t_end:
+            n_events += 1
+            if n_events > self.options.max_events:
+                raise _Stop("too-many-events", f"more than {self.options.max_events} events before "
+                                               f"t = {run.t:.6g} s")
+            if self._hold_rest(scene, run, modes, t_end):
+                break
+            hit = self._segment(scene, run, modes, t_end)
+            if hit is None:
+                break
+            modes = self._switch(scene, run, modes, *hit, names)
+            if modes is None:
+                return "ok", f"stopped at the impact of {names[hit[1]]}"
+        return "ok", "reached t_end"
 
-        for i, mode in enumerate(modes):
-            law = scene.contacts[i].law.friction
-            contact = scene.contacts[i]
+    def _solver(self, scene, modes, t0, y0, t_end):
+        n = scene.n_dof
+        frozen = list(modes)
 
-            if mode == "open":
-                if start_gaps[i] <= opts.gap_tol:
-                    # A flight that starts at the line (a rebound) starts a few ulps above,
-                    # on or below it: a short hop then crosses zero twice within one integrator
-                    # step, or "crosses" at the start, and the touchdown is missed (the body
-                    # falls through) or found at once. Watch for the apex first; from there
-                    # the touchdown is a single, detectable crossing.
-                    def apex_event(t, y, contact=contact):
-                        q, v = split(y)
-                        return float(contact.kinematics(q, v, n_dof).H_N @ v)
-                    apex_event.terminal, apex_event.direction = True, -1
-                    funcs.append(apex_event)
-                    meanings.append(("apex", i))
-                    continue
-                def gap_event(t, y, contact=contact):
-                    q, v = split(y)
-                    return contact.kinematics(q, v, n_dof).gap
-                gap_event.terminal, gap_event.direction = True, -1
-                funcs.append(gap_event)
-                meanings.append(("touchdown", i))
-                continue
+        def rhs(t, y):
+            return np.concatenate([y[n:], mode_dynamics(scene, t, y[:n], y[n:], frozen).a])
+        o = self.options
+        return getattr(scipy.integrate, o.method)(rhs, t0, y0, t_end, rtol=o.rtol, atol=o.atol,
+                                                  max_step=o.max_step)
 
-            def normal_event(t, y, i=i):
-                q, v = split(y)
-                return mode_dynamics(scene, t, q, v, modes).normal_force[i]
-            normal_event.terminal, normal_event.direction = True, -1
-            funcs.append(normal_event)
-            meanings.append(("liftoff", i))
+    def _segment(self, scene, run, modes, t_end):
+        """Integrate `modes` from the run's state, step by step, to the first event or t_end.
+        Returns the event's (kind, contact), or None at t_end; leaves the run at the stop."""
+        indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
+        y0 = np.concatenate([run.q, run.v])
+        watch = _Watch(scene, modes, indicators, run.t, y0)
+        solver = self._solver(scene, modes, run.t, y0, t_end)
+        hit = None
+        try:
+            while solver.status == "running" and hit is None:
+                t_a = solver.t
+                message = solver.step()
+                if solver.status == "failed":
+                    self._stalled(scene, run, modes, solver, y0, message)
+                run.steps += 1
+                dense = solver.dense_output()
+                hit = watch.first_event(dense, t_a, solver.t)
+                t_stop = hit[0] if hit is not None else solver.t
+                self._sample(run, dense, t_a, t_stop, modes)
+        finally:
+            run.nfev += int(solver.nfev)
+            run.indicator_evaluations += watch.evaluations
+        run.close(float(t_stop), dense(t_stop) if hit is not None else solver.y.copy(), modes)
+        return None if hit is None else (indicators[hit[1]].kind, indicators[hit[1]].contact)
 
-            if mode == "stick":
-                if law.mu_s == 0.0:
-                    continue
+    def _sample(self, run, dense, a, b, modes):
+        """Output samples on the grid k·output_dt within [a, b)."""
+        dt = self.options.output_dt
+        ts = np.arange(math.ceil(a / dt) - 1, math.ceil(b / dt) + 1) * dt
+        ts = ts[(ts >= a) & (ts < b)]
+        if ts.size:
+            run.sample(ts, dense(ts).T, modes)
 
-                def upper(t, y, i=i, mu=law.mu_s):
-                    q, v = split(y)
-                    d = mode_dynamics(scene, t, q, v, modes)
-                    return d.tangential_force[i] - mu * d.normal_force[i]
-                upper.terminal, upper.direction = True, 1
+    def _stalled(self, scene, run, modes, solver, y0, message):
+        """The ODE solver failed: a Painlevé stop if the sliding system became singular (it
+        stalls as A → 0 with the normal force unbounded, before det A = 0 is bracketed),
+        else a failure. Keeps the samples up to there."""
+        if not self._sliding_singular(scene, solver.t, solver.y, modes, run.t, y0):
+            raise _Stop("failed", f"integration failed at t = {solver.t:.6g} s in modes {modes}: "
+                                  f"{message}")
+        run.close(float(solver.t), solver.y.copy(), modes)
+        raise _Stop("painleve", f"Painlevé configuration at t = {run.t:.12g} s: the sliding problem loses "
+                                "consistency (A → 0) with the normal force growing without bound; the run "
+                                "stops here")
 
-                def lower(t, y, i=i, mu=law.mu_s):
-                    q, v = split(y)
-                    d = mode_dynamics(scene, t, q, v, modes)
-                    return d.tangential_force[i] + mu * d.normal_force[i]
-                lower.terminal, lower.direction = True, -1
-                funcs += [upper, lower]
-                meanings += [("break-upper", i), ("break-lower", i)]
-            else:
-                if law.mu_s > 0.0:
-                    def slip_event(t, y, contact=contact):
-                        q, v = split(y)
-                        k = contact.kinematics(q, v, n_dof)
-                        return k.H_T @ v - k.surface_velocity
-                    # Only the crossing back through zero counts, not the start of the slip at zero.
-                    slip_event.terminal, slip_event.direction = True, (-1 if mode == "slip+" else 1)
-                    funcs.append(slip_event)
-                    meanings.append(("slip-zero", i))
-                if law.mu_d > 0.0:
-                    def painleve(t, y):
-                        q, v = split(y)
-                        A = mode_dynamics(scene, t, q, v, modes).matrix
-                        return float(np.linalg.det(A))
-                    painleve.terminal, painleve.direction = True, -1
-                    funcs.append(painleve)
-                    meanings.append(("painleve", i))
-        return funcs, meanings
+    # ------------------------------------------------------------------ switches
+    def _switch(self, scene, run, modes, kind, i, names):
+        """The modes after event `kind` of contact i (None: the run stops at this impact)."""
+        t = run.t
+        forced = {}
+        if kind == "painleve":
+            raise _Stop("painleve", f"Painlevé configuration at t = {t:.12g} s: sliding of contact {names[i]} "
+                                    "loses consistency (J/M + ξ cos θ·D → 0); the run stops here")
+        if kind in ("break-upper", "break-lower"):
+            forced[i] = ["slip-" if kind == "break-upper" else "slip+"]
+            run.events.append(Event(t, "stick-slip", names[i], {"to": forced[i][0]}))
+        elif kind == "liftoff":
+            forced[i] = ["open"]
+            run.events.append(Event(t, "liftoff", names[i]))
+        elif kind == "slip-zero":
+            run.events.append(Event(t, "slip-zero", names[i], {"from": modes[i]}))
+            # The slip velocity has just crossed zero: re-stick if μs holds, else reverse.
+            forced[i] = ["stick", "slip+" if modes[i] == "slip-" else "slip-"]
+        elif kind == "touchdown":
+            run.instant = (math.nan, {})  # the impact changed the velocities: decide afresh
+            if self._touchdown(scene, run, modes, i, names):
+                return None
+        new_modes = self._decide_at_instant(scene, run, forced)
+        if kind == "slip-zero":
+            run.events[-1].detail["to"] = new_modes[i]
+        return new_modes
+
+    def _decide_at_instant(self, scene, run, forced):
+        """Events at one instant compose: the modes forced by earlier events at this t still hold
+        (two corners lifting off together must not take turns re-closing each other), unless
+        together they admit no consistent mode."""
+        t_prev, forced_prev = run.instant
+        merged = {**forced_prev, **forced} if abs(run.t - t_prev) <= 8 * _EPS * max(1.0, abs(run.t)) else forced
+        try:
+            new_modes = self._decide(scene, run.t, run.q, run.v, merged)
+        except _Stop:
+            if merged == forced:
+                raise
+            merged = forced
+            new_modes = self._decide(scene, run.t, run.q, run.v, forced)
+        run.instant = (run.t, merged)
+        return new_modes
+
+    def _touchdown(self, scene, run, modes, i, names) -> bool:
+        """Impact of contact i; True if the run stops at it."""
+        t, q, v_before = run.t, run.q, run.v.copy()
+        run.v, pN, pT = self._impact(scene, t, q, v_before, i)
+        if t - run.last_impact_t < self.options.zeno_interval:
+            raise _Stop("zeno", f"impacts accumulate at t = {t:.12g} s (Zeno): the event-driven "
+                                "scheme cannot pass an accumulation point")
+        run.last_impact_t = t
+        run.impacts.append(Impact(t, names[i], q.copy(), v_before, run.v.copy(), pN, pT))
+        run.events.append(Event(t, "impact", names[i]))
+        run.sample(t, np.concatenate([q, run.v]), modes)
+        if self.options.stop_at_impact == names[i]:
+            return True
+        self._check_accumulation(scene, t, q, run.v, i)
+        return False
+
+    def _hold_rest(self, scene, run, modes, t_end) -> bool:
+        """A body at rest (v = 0 within velocity_tol, a = 0 to round-off) in stick or flight under
+        constant forces stays at rest, and no indicator can move: hold the state to t_end in one
+        go instead of integrating nothing. An applied force may change in time: then integrate."""
+        if scene.applied_force is not None or any(m not in ("stick", "open") for m in modes):
+            return False
+        if np.max(np.abs(run.v), initial=0.0) > self.options.velocity_tol:
+            return False
+        v = np.zeros_like(run.v)
+        dyn = mode_dynamics(scene, run.t, run.q, v, modes)
+        a_scale = float(np.max(np.abs(scene.inverse_mass_diagonal * scene.force(run.t, run.q, v))))
+        if not np.all(np.abs(dyn.a) <= 1e-12 * a_scale):
+            return False
+        y = np.concatenate([run.q, v])
+        dt = self.options.output_dt
+        ts = np.arange(math.ceil(run.t / dt), math.ceil(t_end / dt) + 1) * dt
+        ts = ts[(ts >= run.t) & (ts < t_end)]
+        if ts.size:
+            run.sample(ts, np.tile(y, (ts.size, 1)), modes, dyn)
+        run.rest_from = run.t
+        run.close(float(t_end), y, modes, dyn)
+        return True
 
     # ------------------------------------------------------------------ impacts
     def _impact(self, scene, t, q, v, hit):
@@ -291,148 +670,38 @@ class EventDriven:
                             "event-driven scheme cannot pass an accumulation point",
                     {"t_accumulation": t_acc})
 
-    # ------------------------------------------------------------------ main loop
-    def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        require_positive("t_end", t_end)
-        opts = self.options
-        for c in scene.contacts:
-            if not hasattr(c, "line"):
-                raise InputError("the event-driven integrator handles disk/point-on-line contacts only")
-        wall = time.process_time()
-        n_dof = scene.n_dof
-        names = [c.name for c in scene.contacts]
-        t = 0.0
-        q = np.array(q0, dtype=float)
-        v = np.array(v0, dtype=float)
-        events: list[Event] = []
-        impacts: list[Impact] = []
-        samples_t, samples_y, samples_modes = [], [], []
-        boundaries, interval_modes = [0.0], []
-        status, message = "ok", "reached t_end"
-        steps = 0
-        nfev = 0
-        last_impact_t = -math.inf
-        try:
-            modes = self._decide(scene, t, q, v)
-            events.append(Event(0.0, "start", "", {"modes": list(modes)}))
-            grid = np.arange(0.0, t_end + 0.5 * opts.output_dt, opts.output_dt)
-            grid = grid[grid <= t_end]
-            n_events = 0
-            while t < t_end:
-                n_events += 1
-                if n_events > opts.max_events:
-                    raise _Stop("too-many-events", f"more than {opts.max_events} events before t = {t:.6g} s")
-                y0 = np.concatenate([q, v])
-                funcs, meanings = self._event_functions(scene, modes, q, v)
-                frozen = list(modes)
-
-                def rhs(tt, y):
-                    qq, vv = y[:n_dof], y[n_dof:]
-                    a = mode_dynamics(scene, tt, qq, vv, frozen).a
-                    return np.concatenate([vv, a])
-
-                sol = solve_ivp(rhs, (t, t_end), y0, method=opts.method, rtol=opts.rtol, atol=opts.atol,
-                                max_step=opts.max_step,
-                                events=funcs or None, dense_output=True)
-                steps += int(sol.t.size - 1)
-                nfev += int(sol.nfev)
-                singular_stop = False
-                if sol.status == -1:
-                    if not self._sliding_singular(scene, sol.t[-1], sol.y[:, -1], modes, t, y0):
-                        raise _Stop("failed", f"integration failed at t = {sol.t[-1]:.6g} s: {sol.message}")
-                    # The integrator stalled as A → 0 with the normal force unbounded, before the
-                    # painleve event (det A = 0) could be bracketed: the same stop, reached from
-                    # inside the consistent region. Keep the samples up to there.
-                    singular_stop = True
-                # Which event ended the segment (earliest; ties resolved by order)?
-                t_stop, which = sol.t[-1], None
-                if sol.status == 1:
-                    best = math.inf
-                    for j, te in enumerate(sol.t_events):
-                        if te.size and te[0] < best:
-                            best, which = te[0], j
-                    t_stop = best
-                y_stop = sol.sol(t_stop) if which is not None else sol.y[:, -1]
-                inside = grid[(grid >= t) & (grid < t_stop)]
-                for tt in inside:
-                    samples_t.append(tt)
-                    samples_y.append(sol.sol(tt))
-                    samples_modes.append(list(modes))
-                samples_t.append(t_stop)
-                samples_y.append(y_stop)
-                samples_modes.append(list(modes))
-                boundaries.append(t_stop)
-                interval_modes.append(list(modes))
-                t = t_stop
-                q, v = y_stop[:n_dof].copy(), y_stop[n_dof:].copy()
-                if singular_stop:
-                    raise _Stop("painleve",
-                                f"Painlevé configuration at t = {t:.12g} s: the sliding problem loses "
-                                "consistency (A → 0) with the normal force growing without bound; the run "
-                                "stops here")
-                if which is None:
-                    break
-                kind, i = meanings[which]
-                forced = {}
-                if kind == "apex":
-                    modes = self._decide(scene, t, q, v)
-                    continue
-                if kind == "painleve":
-                    raise _Stop("painleve",
-                                f"Painlevé configuration at t = {t:.12g} s: sliding of contact {names[i]} "
-                                "loses consistency (J/M + ξ cos θ·D → 0); the run stops here")
-                if kind in ("break-upper", "break-lower"):
-                    forced[i] = ["slip-" if kind == "break-upper" else "slip+"]
-                    events.append(Event(t, "stick-slip", names[i], {"to": forced[i][0]}))
-                elif kind == "liftoff":
-                    forced[i] = ["open"]
-                    events.append(Event(t, "liftoff", names[i]))
-                elif kind == "slip-zero":
-                    events.append(Event(t, "slip-zero", names[i], {"from": modes[i]}))
-                    # The slip velocity has just crossed zero: re-stick if μs holds, else reverse.
-                    forced[i] = ["stick", "slip+" if modes[i] == "slip-" else "slip-"]
-                elif kind == "touchdown":
-                    v_before = v.copy()
-                    v, pN, pT = self._impact(scene, t, q, v, i)
-                    if t - last_impact_t < opts.zeno_interval:
-                        raise _Stop("zeno", f"impacts accumulate at t = {t:.12g} s (Zeno): the event-driven "
-                                            "scheme cannot pass an accumulation point")
-                    last_impact_t = t
-                    impacts.append(Impact(t, names[i], q.copy(), v_before, v.copy(), pN, pT))
-                    events.append(Event(t, "impact", names[i]))
-                    samples_t.append(t)
-                    samples_y.append(np.concatenate([q, v]))
-                    samples_modes.append(list(modes))
-                    if opts.stop_at_impact == names[i]:
-                        status, message = "ok", f"stopped at the impact of {names[i]}"
-                        break
-                    self._check_accumulation(scene, t, q, v, i)
-                new_modes = self._decide(scene, t, q, v, forced)
-                if kind == "slip-zero":
-                    events[-1].detail["to"] = new_modes[i]
-                modes = new_modes
-        except _Stop as stop:
-            status, message = stop.status, stop.message
-            events.append(Event(t, status, "", {"message": message, **stop.detail}))
-        traj = self._trajectory(scene, samples_t, samples_y, samples_modes)
+    # ------------------------------------------------------------------ results
+    def _result(self, scene, run, names, status, message, cpu_time_s) -> SimulationResult:
+        traj = self._trajectory(scene, run.samples)
         phases = {}
-        if len(boundaries) > 1:
+        if len(run.boundaries) > 1:
             for ci, name in enumerate(names):
-                phases[name] = phases_from_intervals(boundaries, [m[ci] for m in interval_modes])
-        result = SimulationResult(self.name, status, message, traj, names, events, impacts, phases,
-                                  steps=steps, cpu_time_s=time.process_time() - wall,
-                                  stats={"nfev": nfev, "t_final": t})
-        return result
+                phases[name] = phases_from_intervals(run.boundaries, [m[ci] for m in run.interval_modes])
+        stats = {"nfev": run.nfev, "t_final": run.t, "indicator_evaluations": run.indicator_evaluations,
+                 "rest_from": run.rest_from}
+        return SimulationResult(self.name, status, message, traj, names, run.events, run.impacts, phases,
+                                steps=run.steps, cpu_time_s=cpu_time_s, stats=stats)
 
-    def _trajectory(self, scene, ts, ys, modes_list) -> Trajectory:
+    def _trajectory(self, scene, blocks) -> Trajectory:
+        """The samples with their accelerations and forces (from the mode each was taken in;
+        a resting block carries its one solution)."""
         n_dof, nc = scene.n_dof, len(scene.contacts)
-        n = len(ts)
-        q = np.array([y[:n_dof] for y in ys]).reshape(n, n_dof)
-        v = np.array([y[n_dof:] for y in ys]).reshape(n, n_dof)
+        n = sum(len(b[0]) for b in blocks)
+        ts = np.concatenate([b[0] for b in blocks]) if blocks else np.empty(0)
+        y = np.concatenate([b[1] for b in blocks]) if blocks else np.empty((0, 2 * n_dof))
         a = np.full((n, n_dof), np.nan)
         N = np.zeros((n, nc))
         T = np.zeros((n, nc))
-        for k in range(n):
-            d = mode_dynamics(scene, ts[k], q[k], v[k], modes_list[k])
-            a[k], N[k], T[k] = d.a, d.normal_force, d.tangential_force
-        return Trajectory(np.array(ts), q, v, a, N, T, np.array(modes_list, dtype=object).reshape(n, nc))
+        modes = np.empty((n, nc), dtype=object)
+        row = 0
+        for bt, by, bmodes, dyn in blocks:
+            rows = slice(row, row + len(bt))
+            modes[rows] = np.array(bmodes, dtype=object)
+            if dyn is not None:
+                a[rows], N[rows], T[rows] = dyn.a, dyn.normal_force, dyn.tangential_force
+            else:
+                for k in range(len(bt)):
+                    d = mode_dynamics(scene, bt[k], by[k, :n_dof], by[k, n_dof:], bmodes)
+                    a[row + k], N[row + k], T[row + k] = d.a, d.normal_force, d.tangential_force
+            row += len(bt)
+        return Trajectory(ts, y[:, :n_dof], y[:, n_dof:], a, N, T, modes)

@@ -124,9 +124,11 @@ def _most_admissible_split(A, lam0, owners, modes, scene):
             e_t[roles["T"]] = 1.0
             add(mu * e_n - e_t)
             add(mu * e_n + e_t)
-    scale = max(1.0, float(np.max(np.abs(lam0))))
-    res = linprog(np.r_[np.zeros(k), -1.0], A_ub=np.array(rows), b_ub=np.array(rhs),
-                  bounds=[(-1e3 * scale, 1e3 * scale)] * k + [(None, scale)], method="highs")
+    # Solved in units of the forces: HiGHS's tolerances are absolute (1e-7), and at forces that
+    # small (a contact about to lift off) it would return a split on the cone's edge as optimal.
+    scale = float(np.max(np.abs(lam0))) or 1.0
+    res = linprog(np.r_[np.zeros(k), -1.0], A_ub=np.array(rows), b_ub=np.array(rhs) / scale,
+                  bounds=[(-1e3, 1e3)] * k + [(None, 1.0)], method="highs")
     if res.status != 0:
         return lam0
-    return lam0 + Z @ res.x[:k]
+    return lam0 + Z @ (scale * res.x[:k])
