@@ -19,10 +19,29 @@ from .model.scene import Scene
 from .results import ContactState, Event, Impact, Phase, SimulationResult, Status, Trajectory
 from .solvers import ContactSolution, PlanarFrictionProblem, SolverError, solve
 from .validation import InputError
+from . import result_files as _result_files
+from .scenefile import load_scene, simulate_scene
+
+load = _result_files.load
+
+
+def _animate(self, frames: int = 60, fps: int = 20):
+    """An inline HTML animation of the run (for notebooks): bodies, lines and contact forces."""
+    from .plots.animation import animate
+
+    return animate(self, frames=frames, fps=fps)
+
+
+# Files, tables and pictures are applications of a result, not part of it: results.py knows no
+# file format. They are bound here, once, as the methods users expect.
+SimulationResult.save = _result_files.save
+SimulationResult.to_dataframe = _result_files.to_dataframe
+SimulationResult.restart = _result_files.restart
+SimulationResult.animate = _animate
 
 __all__ = [
     "__version__", "simulate", "StopAtImpact", "Scene", "RigidBody", "Line", "DiskOnLine", "PointOnLine",
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
-    "ContactSolution", "SolverError", "InputError",
+    "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",
 ]

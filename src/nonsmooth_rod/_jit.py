@@ -37,18 +37,18 @@ def _choose_cache_dir() -> None:
 
 _choose_cache_dir()
 
-try:  # numba is the optional `fast` extra
-    import numba as _numba
-except ImportError:  # pragma: no cover - exercised on installs without numba
-    _numba = None
+import importlib.util
 
-ENABLED = _numba is not None and os.environ.get("NONSMOOTH_ROD_NO_JIT", "") in ("", "0")
+# numba is the optional `fast` extra; it is imported only when a kernel is first decorated, so
+# `import nonsmooth_rod` stays light.
+HAVE_NUMBA = importlib.util.find_spec("numba") is not None
+ENABLED = HAVE_NUMBA and os.environ.get("NONSMOOTH_ROD_NO_JIT", "") in ("", "0")
 _warned = False
 
 
 def _warn_once() -> None:
     global _warned
-    if _numba is None and not _warned:
+    if not HAVE_NUMBA and not _warned:
         _warned = True
         warnings.warn("numba is not installed: the compiled Moreau–Jean engine is off and runs are about "
                       "30x slower (pip install 'nonsmooth-rod[fast]')", RuntimeWarning, stacklevel=3)
@@ -62,7 +62,9 @@ def jit(function):
     if not ENABLED:
         _warn_once()
         return function
-    return _numba.njit(cache=True)(function)
+    import numba
+
+    return numba.njit(cache=True)(function)
 
 
 __all__ = ["jit", "ENABLED"]

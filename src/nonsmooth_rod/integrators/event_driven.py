@@ -10,7 +10,7 @@ zero crossings of switching indicators, evaluated on each step's dense output:
   and det A (A = H_N M⁻¹ (H_N − s μd H_T)) falls to 0: Painlevé, stop with status "painleve";
 * closed contact: N falls through 0 → contact opens (flight);
 * open contact: gap falls through 0 → impact, solved at impulse level with Newton restitution
-  and two-coefficient Coulomb friction on the impulses (see onestep.py).
+  and two-coefficient Coulomb friction on the impulses (see solvers/two_coefficient.py).
 
 A reference must never miss an event, so sign changes between steps are not enough: an
 indicator may cross and come back within one step (T/N above μs for microseconds near its

@@ -57,7 +57,7 @@ class RunSpec:
     case: int
     knob: str
     value: float
-    options: tuple = ()  # further keyword arguments of rod_simulation.simulate, as pairs
+    options: tuple = ()  # further keyword arguments of rod.simulation.simulate, as pairs
 
     @property
     def knob_label(self) -> str:

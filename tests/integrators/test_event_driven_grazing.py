@@ -12,13 +12,13 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from nonsmooth_rod.integrators.event_driven import EventDriven, EventDrivenOptions
-from nonsmooth_rod.model import rod_closed_form as cf
+from nonsmooth_rod.rod import closed_form as cf
 from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import DiskOnLine, Line, PointOnLine
 from nonsmooth_rod.model.laws import ContactLaw
-from nonsmooth_rod.model.rod import RodProblem
+from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.model.scene import Scene
-from nonsmooth_rod.rod_hypotheses import rolling_hypothesis
+from nonsmooth_rod.rod.hypotheses import rolling_hypothesis
 
 TIGHT = {"rtol": 1e-12, "atol": 1e-12}  # default step cap (none)
 LOOSE = {"rtol": 1e-6, "atol": 1e-6, "max_step": 1.0}

@@ -14,7 +14,7 @@ from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.validation import InputError
 
 G, MASS, WIDTH, HEIGHT, MU_S, MU_D = 9.81, 2.0, 0.2, 0.1, 0.5, 0.4
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_event_driven_rest.py"
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_event_driven_rest.py"
 
 
 def block(applied_force=None):
