@@ -6,11 +6,11 @@ any integrator; this module only translates the general result into the paper's 
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..integrators.event_driven import EventDriven, EventDrivenOptions
 from .problem import RodProblem
 from ..results import Phase, SimulationResult
 from .hypotheses import RollingHypothesis, rolling_hypothesis
@@ -24,14 +24,25 @@ MAX_DURATION = 10.0  # s; without --t-end the run stops at ball B's impact, well
 
 @dataclass
 class RodRun:
+    """A run in the paper's coordinates. `table` and `rolling` are computed when first asked
+    for: a sweep point needs neither, and the rolling hypothesis (an ODE solve) would cost
+    ten times the Moreau–Jean run itself."""
+
     problem: RodProblem
     method: str
     result: SimulationResult
-    table: dict  # TRAJECTORY_COLUMNS → arrays
     phases: list[Phase]
     impact: dict | None
-    rolling: RollingHypothesis
     settings: dict = field(default_factory=dict)
+
+    @functools.cached_property
+    def table(self) -> dict:
+        """TRAJECTORY_COLUMNS → arrays."""
+        return rod_table(self.problem, self.result)
+
+    @functools.cached_property
+    def rolling(self) -> RollingHypothesis:
+        return rolling_hypothesis(self.problem)
 
     @property
     def status(self) -> str:
@@ -106,6 +117,7 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
     scene = problem.scene()
     q0, v0 = problem.initial_state()
     if method == "event-driven":
+        from ..integrators.event_driven import EventDriven, EventDrivenOptions
         rtol = 1e-12 if rtol is None else rtol
         require_positive("rtol", rtol)
         integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, stop_at_impact=stop,
@@ -142,11 +154,9 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
     if t_end is None and result.status == "ok" and not any(i.contact == "B" for i in result.impacts):
         result.status = "no-impact"
         result.message = f"ball B did not strike the plane within {MAX_DURATION:g} s"
-    table = rod_table(problem, result)
     phases = result.phases.get("A", [])
     phases = [Phase("flight" if p.mode == "open" else p.mode, p.t_start, p.t_end) for p in phases]
-    return RodRun(problem, method, result, table, phases, _impact_of_b(problem, result),
-                  rolling_hypothesis(problem), settings)
+    return RodRun(problem, method, result, phases, _impact_of_b(problem, result), settings)
 
 
 def scenario(phases: list[Phase]) -> str:
