@@ -136,7 +136,7 @@ def cmd_sweep(args) -> int:
     if n_points > 2_000_000:
         raise InputError(f"{n_points} grid points is too many (at most 2000000)")
     jobs = _check_numerics(args)
-    formats = _formats(args.format)
+    formats = () if args.no_plot else _formats(args.format)  # (checking them imports matplotlib)
     if not 30 <= args.dpi <= 600:
         raise InputError(f"--dpi must lie in [30, 600], got {args.dpi}")
     map_axes = _map_axes_option(args.map_axes, grid)

@@ -634,7 +634,8 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
     write_rows(csv_path, rows, columns)
     wanted = {point_key(pt) for pt in points}
     grid_rows = [r for r in rows if row_key(r, pcols) in wanted]
-    accuracy = check_accuracy(base, grid, grid_rows, settings, check_points, pool, workers)
+    # The check runs here: 8 reference runs cost less than importing the reference in each worker.
+    accuracy = check_accuracy(base, grid, grid_rows, settings, check_points)
     ths = [thresholds(base, g["theta0_deg"], {k: g[k] for k in grid.extra_names}) for g in grid.groups()]
     files = _write_outputs(out_dir, columns, rows, ths, record, grid, accuracy, command,
                            {"points": len(points), "computed": len(new_rows), "reused": len(points) - len(todo),
@@ -655,22 +656,29 @@ def _write_outputs(out_dir, columns, rows, ths, record, grid, accuracy, command,
     write_json(out_dir / SETTINGS_NAME, record | {"grid": grid_record, "counts": counts, "accuracy": accuracy,
                                                   "provenance": provenance(command)})
     if _has_pyarrow():
-        import pandas as pd
-
-        from ..io import atomic_path
-
-        frame = pd.DataFrame(rows_as_columns(rows, columns), columns=list(columns)).astype(
-            {c: float for c in columns if c not in TEXT_COLUMNS})
-        with atomic_path(out_dir / PARQUET_NAME) as tmp:
-            frame.to_parquet(tmp, index=False)
-        files.append(out_dir / PARQUET_NAME)
+        files.append(write_parquet(out_dir / PARQUET_NAME, rows, columns))
     return files
+
+
+def write_parquet(path: Path, rows, columns) -> Path:
+    """The table as Parquet, atomically (pyarrow alone: pandas costs a second to import)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from ..io import atomic_path
+
+    cols = rows_as_columns(rows, columns)
+    table = pa.table({c: pa.array(cols[c].tolist(), type=pa.string() if c in TEXT_COLUMNS else pa.float64())
+                      for c in columns})
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
+    return path
 
 
 def _has_pyarrow() -> bool:
     import importlib.util
 
-    return importlib.util.find_spec("pyarrow") is not None and importlib.util.find_spec("pandas") is not None
+    return importlib.util.find_spec("pyarrow") is not None
 
 
 # --------------------------------------------------------------------------- accuracy
