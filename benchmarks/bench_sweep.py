@@ -100,8 +100,9 @@ def main(argv=None) -> dict:
     ap.add_argument("--quick", action="store_true", help="small sizes (a test runs this)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="write the numbers as JSON here")
+    ap.add_argument("--skip-map", action="store_true", help="leave out the CLI map (a fresh process)")
     args = ap.parse_args(argv)
-    n_pts, reps, n_map = (20, 3, 20) if args.quick else (200, 15, 100)
+    n_pts, reps, n_map = (20, 3, 10) if args.quick else (200, 15, 100)
     report = {"load_average": os.getloadavg(), "cores": os.cpu_count(), "yardstick_us": yardstick_us()}
     y = report["yardstick_us"]
     print(f"load average {report['load_average'][0]:.2f} on {report['cores']} cores; "
@@ -119,7 +120,7 @@ def main(argv=None) -> dict:
         report["simulate_ratio"][f"{h:g}"] = {"whole_ms": whole, "integrator_ms": inner, "ratio": whole / inner}
         print(f"simulate() at h = {h:g}: whole {whole:.3f} ms, integrator {inner:.3f} ms, ratio {whole / inner:.2f}")
     report["map"] = []
-    for plot in (False, True):
+    for plot in () if args.skip_map else (False, True):
         res = cli_map(n_map, args.jobs, plot)
         report["map"].append(res)
         acc = res["accuracy"]

@@ -17,7 +17,7 @@ axis, then scenario, status, t_transition, t_impact, the state at the impact, ph
 regime_map.parquet when pyarrow is installed), DIR/thresholds.csv (the rolling hypothesis'
 boundaries per θ0 and body), DIR/sweep.json (settings, grid, provenance, accuracy) and the map
 DIR/regime_map.png. Every axis takes START:STOP:N (N values, ends included), a,b,c or one
-number (then it is a fixed value, not an axis). Points run with Moreau–Jean (h = 1e-3, lemke)
+number (then it is a fixed value, not an axis). Points run with Moreau–Jean (h = 2e-3, lemke)
 by default; a random sample is re-run with the event-driven reference and the agreement is
 reported. Rows are appended as they finish: rerunning an interrupted sweep with the same --out
 computes only the missing points."""
@@ -48,7 +48,8 @@ def register(subparsers) -> None:
         g.add_argument(f"--{name}", default=None, help=text)
     num = p.add_argument_group("numerics, execution and output")
     num.add_argument("--method", default="moreau-jean", help="moreau-jean (default) or event-driven")
-    num.add_argument("--h", type=_float, default=1e-3, help="Moreau-Jean step size, s (default 1e-3)")
+    num.add_argument("--h", type=_float, default=2e-3,
+                     help="Moreau-Jean step size, s (default 2e-3: times within 3h = 6 ms of the reference)")
     num.add_argument("--solver", default="lemke", help="Moreau-Jean one-step solver (default lemke)")
     num.add_argument("--check", type=_int, default=8,
                      help="points re-run with the event-driven reference to report the accuracy (default 8)")
