@@ -86,6 +86,9 @@ def open_executor(kind: str = "local", jobs: int = 2, scheduler: str | None = No
             yield None, 1
             return
         pool = local_executor(jobs)
+        # Start (fork) the workers now, before the caller starts threads (a progress bar):
+        # forking while another thread holds a lock can deadlock the child.
+        pool.submit(os.getpid).result()
         try:
             yield pool, jobs
         except BaseException:

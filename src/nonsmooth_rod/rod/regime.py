@@ -586,18 +586,22 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
             return _sweep(base, grid, out_dir, settings, pool, workers, **opts)
 
 
-def _run_points(base, settings, columns, todo, pool, workers, on_rows) -> None:
+def _run_points(base, settings, columns, todo, pool, workers, on_rows, meanwhile=None) -> None:
     """Classify `todo`, in this process (pool None) or in chunks on `pool`; `on_rows` gets each
-    finished chunk's rows as they arrive."""
+    finished chunk's rows as they arrive. `meanwhile()` runs in this process, in a thread
+    while the workers compute (after them without a pool)."""
     if pool is None:
         warm_engine(settings)
         for pt in todo:
             on_rows([classify_point(base, dict(zip(columns, pt)), settings)])
+        if meanwhile is not None:
+            meanwhile()
         return
     # Chunks: little pickling overhead per point, yet a progress bar that moves and enough
     # tasks to balance the workers.
     size = max(1, min(250, len(todo) // (8 * workers)))
     pending = {pool.submit(_classify_chunk, base, settings, columns, chunk) for chunk in _chunks(todo, size)}
+    side = _Background(meanwhile)
     try:
         while pending:
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
@@ -607,6 +611,32 @@ def _run_points(base, settings, columns, todo, pool, workers, on_rows) -> None:
         for fut in pending:
             fut.cancel()
         raise
+    side.join()
+
+
+class _Background:
+    """A function run in a thread; join() re-raises what it raised."""
+
+    def __init__(self, fn):
+        import threading
+
+        self.error = None
+        self.thread = None
+        if fn is not None:
+            self.thread = threading.Thread(target=self._run, args=(fn,), daemon=True, name="sweep-side")
+            self.thread.start()
+
+    def _run(self, fn):
+        try:
+            fn()
+        except BaseException as err:  # handed to the main thread
+            self.error = err
+
+    def join(self):
+        if self.thread is not None:
+            self.thread.join()
+        if self.error is not None:
+            raise self.error
 
 
 def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, formats, dpi, check_points,
@@ -630,15 +660,26 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
             sink.flush()  # a row on disk is a row an interrupted sweep need not redo
             bar.advance(len(rows))
 
-        _run_points(base, settings, pcols, todo, pool, workers, record_rows)
+        side: dict = {}
+
+        def meanwhile():
+            # In this process while the workers run: the reference runs of the accuracy check
+            # (cheaper than importing the reference in every worker), the thresholds, and the
+            # figure's imports.
+            side["refs"] = reference_rows(base, grid, settings, check_points)
+            side["ths"] = [thresholds(base, g["theta0_deg"], {k: g[k] for k in grid.extra_names})
+                           for g in grid.groups()]
+            if plot:
+                import matplotlib.figure  # noqa: F401
+
+        _run_points(base, settings, pcols, todo, pool, workers, record_rows, meanwhile)
     compute_s = time.perf_counter() - started
     rows = sorted_rows(earlier + new_rows, columns)
     write_rows(csv_path, rows, columns)
     wanted = {point_key(pt) for pt in points}
     grid_rows = [r for r in rows if row_key(r, pcols) in wanted]
-    # The check runs here: 8 reference runs cost less than importing the reference in each worker.
-    accuracy = check_accuracy(base, grid, grid_rows, settings, check_points)
-    ths = [thresholds(base, g["theta0_deg"], {k: g[k] for k in grid.extra_names}) for g in grid.groups()]
+    accuracy = check_accuracy(base, grid, grid_rows, settings, check_points, side["refs"])
+    ths = side["ths"]
     files = _write_outputs(out_dir, columns, rows, ths, record, grid, accuracy, command,
                            {"points": len(points), "computed": len(new_rows), "reused": len(points) - len(todo),
                             "compute_wall_s": compute_s, "workers": workers})
@@ -694,15 +735,20 @@ def sample_points(grid: Grid, n: int) -> list[tuple]:
     return [points[i] for i in sorted(pick)]
 
 
-def check_accuracy(base, grid, grid_rows, settings, n, pool=None, workers=1) -> dict:
-    """Re-run a random sample of points with the event-driven reference and compare the
-    scenario, the end of rolling and ball B's impact time with the sweep's rows."""
+def reference_rows(base, grid, settings, n) -> list[dict]:
+    """The event-driven reference at `n` random points of the grid (none if the sweep runs it)."""
+    if settings.method == "event-driven" or n == 0:
+        return []
+    return [classify_point(base, dict(zip(grid.columns, pt)), REFERENCE) for pt in sample_points(grid, n)]
+
+
+def check_accuracy(base, grid, grid_rows, settings, n, refs=None) -> dict:
+    """Compare the scenario, the end of rolling and ball B's impact time of the sweep's rows
+    with the event-driven reference at a random sample of points (`refs` if already run)."""
     if settings.method == "event-driven" or n == 0:
         return {"reference": "event-driven", "checked": 0,
                 "note": "the sweep ran the reference itself" if n else "no check asked for"}
-    sample = sample_points(grid, n)
-    refs: list[dict] = []
-    _run_points(base, REFERENCE, grid.columns, sample, pool, workers, refs.extend)
+    refs = reference_rows(base, grid, settings, n) if refs is None else refs
     by_key = {row_key(r, grid.columns): r for r in grid_rows}
     tol = settings.time_tolerance
     agree, worst, mismatches = 0, {"t_transition": 0.0, "t_impact": 0.0}, []
