@@ -113,7 +113,8 @@ def main(argv=None) -> dict:
                                ("event-driven", REFERENCE, max(4, n_pts // 10))):
         ms = per_point_ms(settings, n)
         report["per_point_ms"][label] = ms
-        print(f"per point, {label:20s} {ms:7.3f} ms CPU  = {ms * 1e3 / y:9.0f} yardsticks  ({1e3 / ms:6.0f} points/s/core)")
+        print(f"per point, {label:20s} {ms:7.3f} ms CPU  = {ms * 1e3 / y:9.0f} yardsticks  "
+              f"({1e3 / ms:6.0f} points/s/core)")
     report["simulate_ratio"] = {}
     for h in (1e-2, 1e-3, 1e-4):
         whole, inner = whole_vs_integrator(h, reps if h > 1e-4 else max(3, reps // 3))
@@ -127,7 +128,8 @@ def main(argv=None) -> dict:
         print(f"CLI map {res['points']} points, {args.jobs} jobs, plot={plot}: wall {res['wall_s']:.2f} s "
               f"(points {res['compute_wall_s']:.2f} s, {res['points'] / res['compute_wall_s']:.0f} points/s), "
               f"CPU {res['cpu_s']:.2f} s; accuracy: scenario {acc.get('scenario_agree')}/{acc.get('checked')}, "
-              f"|Δt| ≤ {max(acc.get('max_abs_error_t_transition_s', 0), acc.get('max_abs_error_t_impact_s', 0)):.2g} s "
+              f"|Δt| ≤ {max(acc.get('max_abs_error_t_transition_s', 0), acc.get('max_abs_error_t_impact_s', 0)):.2g}"
+              " s "
               f"(tolerance {acc.get('time_tolerance_s')} s)")
     if args.out:
         Path(args.out).write_text(json.dumps(report, indent=2, default=float) + "\n")

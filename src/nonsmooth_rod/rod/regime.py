@@ -773,8 +773,9 @@ def accuracy_text(acc: dict) -> str:
         return f"accuracy: not checked ({acc.get('note', '')})"
     verdict = "within" if acc["within_tolerance"] else "NOT within"
     return (f"accuracy vs {acc['reference']} on {acc['checked']} random points: scenario "
-            f"{acc['scenario_agree']}/{acc['checked']}, |Δt| transition ≤ {acc['max_abs_error_t_transition_s']:.2g} s, "
-            f"impact ≤ {acc['max_abs_error_t_impact_s']:.2g} s ({verdict} the stated {acc['time_tolerance_s']:.2g} s)")
+            f"{acc['scenario_agree']}/{acc['checked']}, |Δt| transition ≤ "
+            f"{acc['max_abs_error_t_transition_s']:.2g} s, impact ≤ {acc['max_abs_error_t_impact_s']:.2g} s "
+            f"({verdict} the stated {acc['time_tolerance_s']:.2g} s)")
 
 
 # --------------------------------------------------------------------------- progress
@@ -1011,7 +1012,8 @@ def axes_map_figure(rows, grid: Grid, base: RodProblem, settings: SweepSettings 
     names, code = _scenario_codes(rows)
     Z = np.full((ys.size, xs.size), np.nan)
     for r in sel:
-        Z[np.searchsorted(ys, round(r[y], KEY_DIGITS)), np.searchsorted(xs, round(r[x], KEY_DIGITS))] = code[r["scenario"]]
+        i, j = np.searchsorted(ys, round(r[y], KEY_DIGITS)), np.searchsorted(xs, round(r[x], KEY_DIGITS))
+        Z[i, j] = code[r["scenario"]]
     fig = Figure(figsize=(7.5, 5.6), layout="constrained")
     ax = fig.subplots()
     ax.set_label("map")
