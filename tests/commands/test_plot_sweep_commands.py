@@ -177,3 +177,17 @@ def test_sweep_cli_over_a_geometry_axis_with_the_map_axes(tmp_path, capsys):
     table = read_csv(out / "regime_map.csv")
     assert list(table)[:4] == ["mu_s", "mu_d", "theta0_deg", "length"] and len(table["mu_s"]) == 4
     assert _png_size(out / "regime_map.png")[0] > 200
+
+
+def test_sweep_cli_on_a_dask_scheduler(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        argv = ["sweep", "--mu-s", "0.24:0.32:5", "--theta0-deg", "50,60", "--executor", "dask", "--scheduler",
+                cluster.scheduler_address, "--check", "2", "--no-plot", "--out", str(out)]
+        assert main(argv) == 0
+    report = capsys.readouterr().out
+    assert "10 computed" in report and "scenario 2/2" in report
+    table = read_csv(out / "regime_map.csv")
+    assert table["theta0_deg"].tolist() == [50.0] * 5 + [60.0] * 5
