@@ -321,3 +321,13 @@ def test_dask_local_cluster_with_resume(tmp_path):
     assert again.accuracy == first.accuracy and first.accuracy["within_tolerance"]
     assert reference.grid_rows == again.grid_rows or all(
         a["scenario"] == b["scenario"] for a, b in zip(reference.grid_rows, again.grid_rows))
+
+
+def test_every_cell_of_the_map_is_filled_for_unrounded_tilts(tmp_path):
+    from nonsmooth_rod.rod.regime import regime_map_figure
+
+    grid = Grid(np.array([0.2, 0.3, 0.4]), np.linspace(40.0, 50.0, 4), mu_d_ratio=0.75)  # 43.333…°
+    res = sweep(BASE, grid, tmp_path, jobs=1, plot=False, check_points=0)
+    mesh = axis(regime_map_figure(res.grid_rows, grid, BASE, res.thresholds), "map").collections[0]
+    cells = mesh.get_array()
+    assert cells.size == 12 and not np.ma.is_masked(cells)

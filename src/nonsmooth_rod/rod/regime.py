@@ -845,125 +845,151 @@ def regime_map_figure(rows, grid: Grid, base: RodProblem, ths: list[Thresholds],
     return _friction_map_figure(rows, grid, base, ths, settings)
 
 
+BOUNDARY_STYLES = (("T_over_N_initial", "|T/N(0)|", "k", "-"), ("T_over_N_max", "max T/N", "k", "--"),
+                   ("T_over_N_min", "|min T/N|", "k", ":"))
+
+
+class _MapStyle:
+    """What the panels of one map share: the scenario colours and the μs cells."""
+
+    def __init__(self, rows, grid: Grid):
+        from matplotlib.colors import BoundaryNorm, ListedColormap
+
+        self.names, self.code = _scenario_codes(rows)
+        colours = [SCENARIO_COLOURS.get(n, OTHER_COLOUR) for n in self.names]
+        self.cmap = ListedColormap(colours).with_extremes(bad="white")
+        self.norm = BoundaryNorm(np.arange(len(self.names) + 1) - 0.5, len(self.names))
+        self.mu_s_edges = _edges(grid.mu_s)
+        self.mu_s_vals = np.asarray(sorted(set(np.round(grid.mu_s, KEY_DIGITS))), float)
+        self.x_lo, self.x_hi = self.mu_s_edges[0], self.mu_s_edges[-1]
+        self.by_key = {row_key(r, ("mu_s", "mu_d", "theta0_deg")): r for r in rows}
+
+    def cells(self, ys, mu_d_of) -> np.ndarray:
+        """Scenario codes on (ys × μs); `mu_d_of(y, μs)` → (μd, θ0) of the cell."""
+        Z = np.full((len(ys), self.mu_s_vals.size), np.nan)
+        for i, y in enumerate(ys):
+            for j, ms in enumerate(self.mu_s_vals):
+                r = self.by_key.get(point_key((ms, *mu_d_of(y, ms))))
+                if r is not None:
+                    Z[i, j] = self.code[r["scenario"]]
+        return np.ma.masked_invalid(Z)
+
+    def patches(self):
+        from matplotlib.patches import Patch
+
+        return [Patch(color=SCENARIO_COLOURS.get(n, OTHER_COLOUR), label=n) for n in self.names]
+
+
 def _friction_map_figure(rows, grid: Grid, base: RodProblem, ths: list[Thresholds],
                          settings: SweepSettings = SweepSettings()):
     """Scenario of each grid cell with the analytic boundaries. With μd = R·μs (or one μd) the
     map is μs × θ0 with the boundaries as curves of θ0, and a second panel shows the transition
     and impact times against μs beside the rolling hypothesis' prediction; with a μd grid it is
     μs × μd, one panel per θ0, and the boundaries are vertical lines (they do not depend on μd)."""
-    from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.figure import Figure
-    from matplotlib.patches import Patch
 
-    names, code = _scenario_codes(rows)
-    colours = [SCENARIO_COLOURS.get(n, OTHER_COLOUR) for n in names]
-    cmap = ListedColormap(colours).with_extremes(bad="white")
-    norm = BoundaryNorm(np.arange(len(names) + 1) - 0.5, len(names))
-    mu_s_edges = _edges(grid.mu_s)
-    mu_s_vals = np.asarray(sorted(set(np.round(grid.mu_s, KEY_DIGITS))), float)
-    x_lo, x_hi = mu_s_edges[0], mu_s_edges[-1]
-    boundary_styles = (("T_over_N_initial", "|T/N(0)|", "k", "-"), ("T_over_N_max", "max T/N", "k", "--"),
-                       ("T_over_N_min", "|min T/N|", "k", ":"))
-    by_key = {row_key(r, ("mu_s", "mu_d", "theta0_deg")): r for r in rows}
-
-    ratio = None if grid.ratios is None else float(grid.ratios[0])
+    style = _MapStyle(rows, grid)
     if not grid.varies_mu_d:
-        th_vals = np.asarray(sorted(set(np.round(grid.theta0_deg, KEY_DIGITS - 2))), float)
         fig = Figure(figsize=(13, 5.2), layout="constrained")
         ax, ax_t = fig.subplots(1, 2, width_ratios=(1.25, 1))
-        ax.set_label("map")
-        ax_t.set_label("times")
-        Z = np.full((th_vals.size, mu_s_vals.size), np.nan)
-        for i, th in enumerate(th_vals):
-            for j, ms in enumerate(mu_s_vals):
-                md = min(ms, ratio * ms) if ratio is not None else float(grid.mu_d[0])
-                r = by_key.get(point_key((ms, md, th)))
-                if r is not None:
-                    Z[i, j] = code[r["scenario"]]
-        ax.pcolormesh(mu_s_edges, _edges(th_vals), np.ma.masked_invalid(Z), cmap=cmap, norm=norm)
-        # Boundaries as curves of θ0 (a fine θ0 grid when the map has several rows).
-        if th_vals.size > 1:
-            fine = np.linspace(th_vals[0], th_vals[-1], 40)
-            fine_th = [thresholds(base, th) for th in fine]
-            ys = fine
-        else:
-            fine_th = ths[:1]
-            ys = None
-        off = []
-        for key, label, colour, ls in boundary_styles:
-            vals = np.array([abs(getattr(t, key)) for t in fine_th])
-            if ys is None:
-                ax.axvline(vals[0], color=colour, ls=ls, lw=1.4, label=f"{label} = {vals[0]:.4f}", gid=key)
-            else:
-                ax.plot(vals, ys, color=colour, ls=ls, lw=1.4, label=label, gid=key)
-            off += [f"{label} ≥ {v.min():.3g}" for v in [vals] if v.min() > x_hi]
-        ax.set_xlim(x_lo, x_hi)
-        ax.set(xlabel="μs", ylabel="θ0 [°]")
-        if th_vals.size == 1:
-            ax.set_yticks(th_vals)
-        mu_d_text = f"μd = {ratio:g}·μs" if ratio is not None else f"μd = {float(grid.mu_d[0]):g}"
-        ax.set_title(f"scenario ({mu_d_text}, {settings.method})")
-        handles = [Patch(color=SCENARIO_COLOURS.get(n, OTHER_COLOUR), label=n) for n in names]
-        handles += ax.get_legend_handles_labels()[0]
-        ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(0, -0.13), ncol=3)
-        if off:
-            ax.text(0.99, 0.02, "off the map: " + "; ".join(off) + "\n(roll-to-impact lies beyond)",
-                    transform=ax.transAxes, ha="right", va="bottom", fontsize=8,
-                    bbox=dict(fc="white", ec="0.7", alpha=0.9))
-        # Times against μs for a few θ0 rows, beside the rolling hypothesis' transition time.
-        picks = th_vals if th_vals.size <= 4 else th_vals[np.linspace(0, th_vals.size - 1, 4).round().astype(int)]
-        fine_mu = np.linspace(x_lo, x_hi, 300)
-        for k, th in enumerate(picks):
-            colour = f"C{k}"
-            th_obj = next((t for t in ths if abs(t.theta0_deg - th) < 1e-9), None) or thresholds(base, th)
-            pred = np.array([predicted_scenario(th_obj.rolling, m)[1] for m in fine_mu])
-            ax_t.plot(fine_mu, pred, color=colour, lw=1.0, ls="--", gid=f"predicted:{th:g}")
-            sel = [r for r in rows if abs(r["theta0_deg"] - th) < 1e-9]
-            sel.sort(key=lambda r: r["mu_s"])
-            ms = [r["mu_s"] for r in sel]
-            ax_t.plot(ms, [r["t_transition"] for r in sel], "o", color=colour, ms=4,
-                      gid=f"t_transition:{th:g}", label=f"θ0 = {th:g}°: end of rolling")
-            ax_t.plot(ms, [r["t_impact"] for r in sel], "s", color=colour, ms=4, mfc="none",
-                      gid=f"t_impact:{th:g}", label=f"θ0 = {th:g}°: impact of B")
-        ax_t.plot([], [], "k--", lw=1.0, label="rolling hypothesis: |T/N| reaches μs")
-        ax_t.set(xlabel="μs", ylabel="t [s]", title="end of rolling and impact time", xlim=(x_lo, x_hi))
-        ax_t.grid(alpha=0.3)
-        ax_t.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, -0.13), ncol=2)
+        th_vals = _theta_map_panel(ax, style, grid, base, ths, settings)
+        _times_panel(ax_t, rows, base, ths, th_vals, style.x_lo, style.x_hi)
     else:
-        n = len(grid.theta0_deg)
-        cols = min(n, 3)
-        fig = Figure(figsize=(5.2 * cols, 4.6 * math.ceil(n / cols) + 0.6), layout="constrained")
-        axes = np.atleast_1d(fig.subplots(math.ceil(n / cols), cols, squeeze=False)).ravel()
-        md_vals = np.asarray(sorted(set(np.round(grid.mu_d, KEY_DIGITS))), float)
-        for ax, th, th_obj in zip(axes, grid.theta0_deg, ths):
-            ax.set_label(f"map:{th:g}")
-            Z = np.full((md_vals.size, mu_s_vals.size), np.nan)
-            for i, md in enumerate(md_vals):
-                for j, ms in enumerate(mu_s_vals):
-                    r = by_key.get(point_key((ms, md, th)))
-                    if r is not None:
-                        Z[i, j] = code[r["scenario"]]
-            ax.pcolormesh(mu_s_edges, _edges(md_vals), np.ma.masked_invalid(Z), cmap=cmap, norm=norm)
-            lim = (min(x_lo, md_vals[0]), max(x_hi, md_vals[-1]))
-            ax.plot(lim, lim, color="0.5", lw=0.8, label="μd = μs (white above: μd > μs)")
-            off = []
-            for key, label, colour, ls in boundary_styles:
-                v = abs(getattr(th_obj, key))
-                if x_lo <= v <= x_hi:
-                    ax.axvline(v, color=colour, ls=ls, lw=1.4, label=f"{label} = {v:.4f}", gid=key)
-                else:
-                    off.append(f"{label} = {v:.3g}")
-            if off:
-                ax.text(0.99, 0.02, "off the map: " + "; ".join(off), transform=ax.transAxes, ha="right",
-                        va="bottom", fontsize=8, bbox=dict(fc="white", ec="0.7", alpha=0.9))
-            ax.set(xlim=(x_lo, x_hi), ylim=(_edges(md_vals)[0], _edges(md_vals)[-1]), xlabel="μs", ylabel="μd",
-                   title=f"θ0 = {th:g}° ({settings.method})")
-            ax.legend(fontsize=7, loc="upper left")
-        for ax in axes[n:]:
-            ax.axis("off")
-        fig.legend(handles=[Patch(color=SCENARIO_COLOURS.get(nm, OTHER_COLOUR), label=nm) for nm in names],
-                   loc="outside lower center", ncol=len(names), fontsize=8)
+        fig = _mu_d_panels(style, grid, ths, settings)
     fig.suptitle("Regime map: the paper's scenarios, with the boundaries of the pure-rolling hypothesis")
+    return fig
+
+
+def _theta_map_panel(ax, style: _MapStyle, grid: Grid, base, ths, settings) -> np.ndarray:
+    ax.set_label("map")
+    ratio = None if grid.ratios is None else float(grid.ratios[0])
+    th_vals = np.asarray(sorted(set(np.round(grid.theta0_deg, KEY_DIGITS))), float)
+
+    def mu_d_of(th, ms):
+        return (min(ms, ratio * ms) if ratio is not None else float(grid.mu_d[0])), th
+
+    ax.pcolormesh(style.mu_s_edges, _edges(th_vals), style.cells(th_vals, mu_d_of), cmap=style.cmap,
+                  norm=style.norm)
+    # Boundaries as curves of θ0 (a fine θ0 grid when the map has several rows).
+    ys = np.linspace(th_vals[0], th_vals[-1], 40) if th_vals.size > 1 else None
+    fine_th = [thresholds(base, th) for th in ys] if ys is not None else ths[:1]
+    off = []
+    for key, label, colour, ls in BOUNDARY_STYLES:
+        vals = np.array([abs(getattr(t, key)) for t in fine_th])
+        if ys is None:
+            ax.axvline(vals[0], color=colour, ls=ls, lw=1.4, label=f"{label} = {vals[0]:.4f}", gid=key)
+        else:
+            ax.plot(vals, ys, color=colour, ls=ls, lw=1.4, label=label, gid=key)
+        off += [f"{label} ≥ {vals.min():.3g}"] if vals.min() > style.x_hi else []
+    ax.set_xlim(style.x_lo, style.x_hi)
+    ax.set(xlabel="μs", ylabel="θ0 [°]")
+    if th_vals.size == 1:
+        ax.set_yticks(th_vals)
+    mu_d_text = f"μd = {ratio:g}·μs" if ratio is not None else f"μd = {float(grid.mu_d[0]):g}"
+    ax.set_title(f"scenario ({mu_d_text}, {settings.method})")
+    handles = style.patches() + ax.get_legend_handles_labels()[0]
+    ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(0, -0.13), ncol=3)
+    if off:
+        ax.text(0.99, 0.02, "off the map: " + "; ".join(off) + "\n(roll-to-impact lies beyond)",
+                transform=ax.transAxes, ha="right", va="bottom", fontsize=8,
+                bbox=dict(fc="white", ec="0.7", alpha=0.9))
+    return th_vals
+
+
+def _times_panel(ax_t, rows, base, ths, th_vals, x_lo, x_hi) -> None:
+    """Times against μs for a few θ0 rows, beside the rolling hypothesis' transition time."""
+    ax_t.set_label("times")
+    picks = th_vals if th_vals.size <= 4 else th_vals[np.linspace(0, th_vals.size - 1, 4).round().astype(int)]
+    fine_mu = np.linspace(x_lo, x_hi, 300)
+    for k, th in enumerate(picks):
+        colour = f"C{k}"
+        th_obj = next((t for t in ths if abs(t.theta0_deg - th) < 1e-9), None) or thresholds(base, th)
+        pred = np.array([predicted_scenario(th_obj.rolling, m)[1] for m in fine_mu])
+        ax_t.plot(fine_mu, pred, color=colour, lw=1.0, ls="--", gid=f"predicted:{th:g}")
+        sel = sorted((r for r in rows if abs(r["theta0_deg"] - th) < 1e-9), key=lambda r: r["mu_s"])
+        ms = [r["mu_s"] for r in sel]
+        ax_t.plot(ms, [r["t_transition"] for r in sel], "o", color=colour, ms=4,
+                  gid=f"t_transition:{th:g}", label=f"θ0 = {th:g}°: end of rolling")
+        ax_t.plot(ms, [r["t_impact"] for r in sel], "s", color=colour, ms=4, mfc="none",
+                  gid=f"t_impact:{th:g}", label=f"θ0 = {th:g}°: impact of B")
+    ax_t.plot([], [], "k--", lw=1.0, label="rolling hypothesis: |T/N| reaches μs")
+    ax_t.set(xlabel="μs", ylabel="t [s]", title="end of rolling and impact time", xlim=(x_lo, x_hi))
+    ax_t.grid(alpha=0.3)
+    ax_t.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, -0.13), ncol=2)
+
+
+def _mu_d_panels(style: _MapStyle, grid: Grid, ths, settings):
+    """μs × μd, one panel per θ0, the boundaries as vertical lines."""
+    from matplotlib.figure import Figure
+
+    n = len(grid.theta0_deg)
+    cols = min(n, 3)
+    fig = Figure(figsize=(5.2 * cols, 4.6 * math.ceil(n / cols) + 0.6), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(math.ceil(n / cols), cols, squeeze=False)).ravel()
+    md_vals = np.asarray(sorted(set(np.round(grid.mu_d, KEY_DIGITS))), float)
+    x_lo, x_hi = style.x_lo, style.x_hi
+    for ax, th, th_obj in zip(axes, grid.theta0_deg, ths):
+        ax.set_label(f"map:{th:g}")
+        cells = style.cells(md_vals, lambda md, ms, th=th: (md, th))
+        ax.pcolormesh(style.mu_s_edges, _edges(md_vals), cells, cmap=style.cmap, norm=style.norm)
+        lim = (min(x_lo, md_vals[0]), max(x_hi, md_vals[-1]))
+        ax.plot(lim, lim, color="0.5", lw=0.8, label="μd = μs (white above: μd > μs)")
+        off = []
+        for key, label, colour, ls in BOUNDARY_STYLES:
+            v = abs(getattr(th_obj, key))
+            if x_lo <= v <= x_hi:
+                ax.axvline(v, color=colour, ls=ls, lw=1.4, label=f"{label} = {v:.4f}", gid=key)
+            else:
+                off.append(f"{label} = {v:.3g}")
+        if off:
+            ax.text(0.99, 0.02, "off the map: " + "; ".join(off), transform=ax.transAxes, ha="right",
+                    va="bottom", fontsize=8, bbox=dict(fc="white", ec="0.7", alpha=0.9))
+        ax.set(xlim=(x_lo, x_hi), ylim=(_edges(md_vals)[0], _edges(md_vals)[-1]), xlabel="μs", ylabel="μd",
+               title=f"θ0 = {th:g}° ({settings.method})")
+        ax.legend(fontsize=7, loc="upper left")
+    for ax in axes[n:]:
+        ax.axis("off")
+    fig.legend(handles=style.patches(), loc="outside lower center", ncol=len(style.names), fontsize=8)
     return fig
 
 
