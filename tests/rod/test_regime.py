@@ -331,3 +331,29 @@ def test_every_cell_of_the_map_is_filled_for_unrounded_tilts(tmp_path):
     mesh = axis(regime_map_figure(res.grid_rows, grid, BASE, res.thresholds), "map").collections[0]
     cells = mesh.get_array()
     assert cells.size == 12 and not np.ma.is_masked(cells)
+
+
+@pytest.mark.parametrize("y", ["mu_d_ratio", "theta0_deg"])
+def test_map_over_two_axes_shows_every_point_of_that_plane(tmp_path, y):
+    from nonsmooth_rod.rod.regime import axes_map_figure
+
+    mu = np.array([0.2, 0.27, 0.3, 0.4])
+    grid = Grid(mu, np.array([45.0, 60.0]), mu_d_ratio=np.array([0.5, 0.8, 1.0]))
+    res = sweep(BASE, grid, tmp_path, jobs=1, plot=False, check_points=0)
+    ax = axis(axes_map_figure(res.grid_rows, grid, BASE, x="mu_s", y=y), "map")
+    cells = ax.collections[0].get_array()
+    names, _ = regime._scenario_codes(res.grid_rows)
+    held = "theta0_deg" if y == "mu_d_ratio" else "mu_d_ratio"
+    plane = [r for r in res.grid_rows if r[held] == min(r2[held] for r2 in res.grid_rows)]
+    assert cells.size == len(plane) == 4 * (3 if y == "mu_d_ratio" else 2) and not np.ma.is_masked(cells)
+    # Row-major over (y, μs): the plane's rows sorted the same way.
+    plane.sort(key=lambda r: (r[y], r["mu_s"]))
+    assert [names[int(c)] for c in np.asarray(cells).ravel()] == [r["scenario"] for r in plane]
+    # With μs along x the boundaries are drawn: |T/N(0)| at 60° is 0.2628.
+    (start,) = [ln for ln in ax.get_lines() if ln.get_gid() == "T_over_N_initial"]
+    if y == "mu_d_ratio":
+        assert start.get_xdata()[0] == pytest.approx(thresholds(BASE, 45.0).T_over_N_initial, abs=1e-9)
+    else:
+        assert list(start.get_xdata()) == pytest.approx([thresholds(BASE, t).T_over_N_initial for t in (45, 60)])
+    with pytest.raises(InputError, match="cannot map axis"):
+        axes_map_figure(res.grid_rows, grid, BASE, x="mu_s", y="mu_d")

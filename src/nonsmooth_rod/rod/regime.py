@@ -1007,8 +1007,14 @@ AXIS_LABELS = {"mu_s": "μs", "mu_d": "μd", "mu_d_ratio": "μd/μs", "theta0_de
 FRICTION_ONLY_AXES = ("mu_d", "mu_d_ratio", "restitution")  # the rolling thresholds do not depend on them
 
 
+def _independent_axes(grid: Grid) -> list[str]:
+    """The axes a map can use: given ones that are table columns (μd is derived when the
+    ratio is the axis; a single ratio is no column)."""
+    return [c for c in grid.axes if c in grid.columns]
+
+
 def _map_axes(grid: Grid, x, y) -> tuple[str, str]:
-    cols = grid.columns
+    cols = _independent_axes(grid)
     for name in (x, y):
         if name is not None and name not in cols:
             raise InputError(f"cannot map axis {name!r}: this sweep's axes are {', '.join(cols)}")
@@ -1030,7 +1036,7 @@ def axes_map_figure(rows, grid: Grid, base: RodProblem, settings: SweepSettings 
     from matplotlib.patches import Patch
 
     x, y = _map_axes(grid, x, y)
-    others = [c for c in grid.columns if c not in (x, y)]
+    others = [c for c in _independent_axes(grid) if c not in (x, y)]
     held = {c: min(r[c] for r in rows) for c in others if rows}
     sel = [r for r in rows if all(round(r[c] - held[c], KEY_DIGITS) == 0 for c in others)]
     xs = np.unique(np.round([r[x] for r in sel], KEY_DIGITS))
