@@ -369,23 +369,23 @@ class Grid:
 
 
 def point_key(values) -> tuple:
-    return tuple(round(float(v), KEY_DIGITS) for v in values)
+    return tuple([round(float(v), KEY_DIGITS) for v in values])
 
 
 def row_key(row: dict, columns) -> tuple:
-    return point_key(row[c] for c in columns)
+    return tuple([round(float(row[c]), KEY_DIGITS) for c in columns])
 
 
 # --------------------------------------------------------------------------- CSV rows
 def _cell(value) -> str:
     if isinstance(value, float):
-        return "" if math.isnan(value) else f"{value:.17g}"
+        return "" if value != value else repr(float(value))  # shortest round-trip text; NaN empty
     return str(value)
 
 
-def _row_line(row: dict, columns) -> str:
+def _row_lines(rows, columns) -> str:
     buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerow([_cell(row[c]) for c in columns])
+    csv.writer(buf, lineterminator="\n").writerows([[_cell(row[c]) for c in columns] for row in rows])
     return buf.getvalue()
 
 
@@ -440,7 +440,7 @@ def sorted_rows(rows, columns=CSV_COLUMNS) -> list[dict]:
 
 
 def write_rows(path, rows, columns=CSV_COLUMNS) -> None:
-    write_text(path, ",".join(columns) + "\n" + "".join(_row_line(r, columns) for r in sorted_rows(rows, columns)))
+    write_text(path, ",".join(columns) + "\n" + _row_lines(sorted_rows(rows, columns), columns))
 
 
 def rows_as_columns(rows, columns=CSV_COLUMNS) -> dict:
@@ -655,7 +655,7 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
         bar.advance(len(points) - len(todo))
 
         def record_rows(rows):
-            sink.write("".join(_row_line(row, columns) for row in rows))
+            sink.write(_row_lines(rows, columns))
             new_rows.extend(rows)
             sink.flush()  # a row on disk is a row an interrupted sweep need not redo
             bar.advance(len(rows))
