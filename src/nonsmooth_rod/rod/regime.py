@@ -564,7 +564,8 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
     executor: None or "local" (a process pool of `jobs` workers; in this process for jobs = 1),
     "dask" (a dask.distributed LocalCluster of `jobs` workers, or the scheduler at `scheduler`),
     or any concurrent.futures-style executor (a Dask client's get_executor(), loky, a
-    ProcessPoolExecutor), used as given and not shut down here."""
+    ProcessPoolExecutor), used as given and not shut down here; `jobs` then only sizes the
+    chunks (give the number of workers). The table in memory: `result.frame`."""
     if jobs < 1:
         raise InputError(f"jobs must be at least 1, got {jobs}")
     if not 0 <= check_points <= 1000:
