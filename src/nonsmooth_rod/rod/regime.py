@@ -465,7 +465,10 @@ class SweepResult:
     @property
     def frame(self):
         """This grid's rows as a pandas DataFrame (one column per axis and per result)."""
-        import pandas as pd
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("SweepResult.frame needs pandas: pip install 'nonsmooth-rod[tables]'") from None
 
         return pd.DataFrame(rows_as_columns(self.grid_rows, self.columns), columns=list(self.columns)).astype(
             {c: float for c in self.columns if c not in TEXT_COLUMNS})
