@@ -145,12 +145,8 @@ def cmd_sweep(args) -> int:
     base = build_problem(body_args)
     settings = SweepSettings(method=args.method, h=args.h, solver=args.solver)
     result = sweep(base, grid, args.out, settings, jobs=jobs, executor=args.executor, scheduler=args.scheduler,
-                   plot=False, progress=not args.quiet and sys.stderr.isatty(), check_points=args.check)
-    if not args.no_plot:
-        from ..rod.plotting import save_figure
-        from ..rod.regime import MAP_NAME, regime_map_figure
-        fig = regime_map_figure(result.grid_rows, grid, base, result.thresholds, settings, *map_axes)
-        result.files += save_figure(fig, result.out_dir / MAP_NAME, formats, args.dpi)
+                   plot=not args.no_plot, formats=formats, dpi=args.dpi, map_axes=map_axes,
+                   progress=not args.quiet and sys.stderr.isatty(), check_points=args.check)
     if not args.quiet:
         _report(result)
     failed = [r for r in result.grid_rows if r["scenario"] in ("failed",)]

@@ -560,7 +560,8 @@ def _check_problems(base: RodProblem, grid: Grid) -> None:
 
 def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = SweepSettings(), *,
           jobs: int = 2, executor=None, scheduler: str | None = None, progress: bool = False, plot: bool = True,
-          formats=("png",), dpi: int = 110, check_points: int = CHECK_POINTS, command=None) -> SweepResult:
+          formats=("png",), dpi: int = 110, check_points: int = CHECK_POINTS, map_axes=(None, None),
+          command=None) -> SweepResult:
     """Classify every grid point (skipping the ones out_dir already holds), write the tables,
     sweep.json and the map; see the module doc.
 
@@ -568,7 +569,8 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
     "dask" (a dask.distributed LocalCluster of `jobs` workers, or the scheduler at `scheduler`),
     or any concurrent.futures-style executor (a Dask client's get_executor(), loky, a
     ProcessPoolExecutor), used as given and not shut down here; `jobs` then only sizes the
-    chunks (give the number of workers). The table in memory: `result.frame`."""
+    chunks (give the number of workers). `map_axes`: the figure's (x, y) axes (default: see
+    `regime_map_figure`). The table in memory: `result.frame`."""
     if jobs < 1:
         raise InputError(f"jobs must be at least 1, got {jobs}")
     if not 0 <= check_points <= 1000:
@@ -578,7 +580,8 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
         raise InputError(f"--out '{out_dir}' exists and is not a folder")
     _check_problems(base, grid)
     out_dir.mkdir(parents=True, exist_ok=True)
-    opts = dict(progress=progress, plot=plot, formats=formats, dpi=dpi, check_points=check_points, command=command)
+    opts = dict(progress=progress, plot=plot, formats=formats, dpi=dpi, check_points=check_points,
+                map_axes=tuple(map_axes), command=command)
     with folder_lock(out_dir):
         if executor is not None and not isinstance(executor, str):
             return _sweep(base, grid, out_dir, settings, executor, jobs, **opts)
@@ -644,7 +647,7 @@ class _Background:
 
 
 def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, formats, dpi, check_points,
-           command) -> SweepResult:
+           map_axes, command) -> SweepResult:
     started = time.perf_counter()
     columns = grid.columns + RESULT_COLUMNS
     pcols = grid.columns
@@ -674,7 +677,7 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
             side["ths"] = [thresholds(base, g["theta0_deg"], {k: g[k] for k in grid.extra_names})
                            for g in grid.groups()]
             if plot:
-                import matplotlib.figure  # noqa: F401
+                from . import plotting  # noqa: F401  (imports matplotlib)
 
         _run_points(base, settings, pcols, todo, pool, workers, record_rows, meanwhile)
     compute_s = time.perf_counter() - started
@@ -689,8 +692,8 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
                             "compute_wall_s": compute_s, "workers": workers})
     if plot:
         from .plotting import save_figure
-        files += save_figure(regime_map_figure(grid_rows, grid, base, ths, settings), out_dir / MAP_NAME,
-                             formats, dpi)
+        files += save_figure(regime_map_figure(grid_rows, grid, base, ths, settings, *map_axes),
+                             out_dir / MAP_NAME, formats, dpi)
     return SweepResult(out_dir, rows, grid_rows, len(new_rows), len(points) - len(todo), ths, files, columns,
                        accuracy, time.perf_counter() - started, compute_s)
 
