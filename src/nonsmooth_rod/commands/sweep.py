@@ -70,7 +70,7 @@ def register(subparsers) -> None:
 def _grid_and_body(args):
     """The grid from the range options, and the options for the base body: an option with one
     value is a fixed value of the body, not an axis."""
-    from ..rod.regime import Grid, parse_range
+    from ..rod.regime import Grid, check_axis_values, parse_range
 
     body_args = copy.copy(args)
     extra = {}
@@ -81,6 +81,7 @@ def _grid_and_body(args):
             setattr(body_args, attr, 0.0 if attr == "restitution" else None)
             continue
         values = parse_range(text, f"--{name}", max_count=200)
+        check_axis_values(attr, values)
         if values.size == 1:
             setattr(body_args, attr, float(values[0]))
         else:

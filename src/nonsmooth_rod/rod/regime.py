@@ -264,10 +264,37 @@ def parse_range(text: str, name: str, *, max_count: int = 2000) -> np.ndarray:
         raise InputError(f"{name}: values must be finite, got {text!r}")
     if values.size > max_count:
         raise InputError(f"{name}: at most {max_count} values, got {values.size}")
-    rounded = np.round(values, KEY_DIGITS)
-    if np.unique(rounded).size != rounded.size:
+    if _has_repeats(values):
         raise InputError(f"{name}: a value is given twice in {text!r}")
     return values
+
+
+# What a sweep accepts per axis (lo, hi, lo open, hi open): beyond these the physics overflows
+# or stops being the paper's (a rod of 100 m, a density above osmium's ×5, μ above 100).
+AXIS_LIMITS = {"mu_s": (0.0, 100.0, False, False), "mu_d": (0.0, 100.0, False, False),
+               "mu_d_ratio": (0.0, 1.0, False, False), "theta0_deg": (0.0, 90.0, True, True),
+               "ball_radius": (0.0, 10.0, True, False), "rod_diameter": (0.0, 10.0, True, False),
+               "length": (0.0, 100.0, True, False), "density": (0.0, 1e5, True, False),
+               "restitution": (0.0, 1.0, False, False)}
+
+
+def check_axis_values(name: str, values) -> None:
+    """Refuse values of axis `name` outside AXIS_LIMITS, naming the option and the range."""
+    lo, hi, open_lo, open_hi = AXIS_LIMITS[name]
+    v = np.asarray(values, dtype=float)
+    bad = v[~((v > lo if open_lo else v >= lo) & (v < hi if open_hi else v <= hi))]
+    if bad.size:
+        interval = f"{'(' if open_lo else '['}{lo:g}, {hi:g}{')' if open_hi else ']'}"
+        raise InputError(f"--{name.replace('_', '-')}: values must lie in {interval}, got {bad[0]:g}")
+
+
+def _has_repeats(values: np.ndarray) -> bool:
+    """Two values equal to KEY_DIGITS decimals (the resume key). Huge values are refused by
+    the axis limits later; rounding them must not warn of an overflow first."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        rounded = np.round(values, KEY_DIGITS)
+    rounded = np.where(np.isfinite(rounded), rounded, values)
+    return np.unique(rounded).size != rounded.size
 
 
 def _axis_array(name: str, values) -> np.ndarray:
@@ -276,7 +303,7 @@ def _axis_array(name: str, values) -> np.ndarray:
         raise InputError(f"--{name.replace('_', '-')}: no values")
     if not np.all(np.isfinite(arr)):
         raise InputError(f"--{name.replace('_', '-')}: values must be finite, got {arr.tolist()}")
-    if np.unique(np.round(arr, KEY_DIGITS)).size != arr.size:
+    if _has_repeats(arr):
         raise InputError(f"--{name.replace('_', '-')}: a value is given twice: {arr.tolist()}")
     return arr
 
@@ -308,20 +335,14 @@ class Grid:
             raise InputError("no grid point has mu_d ≤ mu_s: nothing to sweep")
 
     def _check_ranges(self):
-        if np.any(self.mu_s < 0):
-            raise InputError("--mu-s: friction coefficients must be non-negative")
-        if np.any((self.theta0_deg <= 0) | (self.theta0_deg >= 90)):
-            raise InputError("--theta0-deg: values must lie in (0, 90)")
-        if self.ratios is not None and np.any((self.ratios < 0) | (self.ratios > 1)):
-            raise InputError(f"--mu-d-ratio must lie in [0, 1] (μd ≤ μs), got {self.ratios.tolist()}")
-        if self.mu_d is not None and np.any(self.mu_d < 0):
-            raise InputError("--mu-d: friction coefficients must be non-negative")
-        for name in GEOMETRY_AXES:
-            if name in self.extra and np.any(self.extra[name] <= 0):
-                raise InputError(f"--{name.replace('_', '-')}: values must be positive")
-        e = self.extra.get("restitution")
-        if e is not None and np.any((e < 0) | (e > 1)):
-            raise InputError("--restitution: values must lie in [0, 1]")
+        check_axis_values("mu_s", self.mu_s)
+        check_axis_values("theta0_deg", self.theta0_deg)
+        if self.ratios is not None:
+            check_axis_values("mu_d_ratio", self.ratios)
+        if self.mu_d is not None:
+            check_axis_values("mu_d", self.mu_d)
+        for name, values in self.extra.items():
+            check_axis_values(name, values)
 
     @property
     def varies_ratio(self) -> bool:
