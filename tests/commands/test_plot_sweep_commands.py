@@ -117,7 +117,7 @@ def test_paper_figures_without_a_folder(tmp_path):
     (["sweep", "--mu-s", "0.1:0.3:3", "--map-axes", "mu_s,density", "--out", "{tmp}/s"], "cannot map axis"),
     (["sweep", "--mu-s", "0.1:0.3:3", "--check", "-1", "--out", "{tmp}/s"], "--check"),
     (["sweep", "--mu-s", "1e308", "--out", "{tmp}/s"], "--mu-s: values must lie in [0, 100]"),
-    (["sweep", "--mu-s", "0.1:0.3:3", "--length", "1e308", "--out", "{tmp}/s"], "--length: values must lie in (0, 100]"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--length", "1e308", "--out", "{tmp}/s"], "values must lie in (0, 100]"),
     (["sweep", "--mu-s", "0.1:0.3:3", "--density", "1e308,7800", "--out", "{tmp}/s"], "(0, 100000]"),
     (["sweep", "--mu-s", "0.1:0.3:3", "--ball-radius", "0.001,0.02", "--out", "{tmp}/s"], "rod diameter"),
 ])
