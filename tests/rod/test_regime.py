@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from nonsmooth_rod.rod import regime
-from nonsmooth_rod.rod.problem import RodProblem
+from nonsmooth_rod.rod.problem import RodGeometry, RodProblem
 from nonsmooth_rod.rod.plotting import axis
 from nonsmooth_rod.rod.regime import (
     CSV_COLUMNS,
@@ -285,7 +285,7 @@ def test_geometry_and_restitution_axes(tmp_path):
     by_r = {t.params["ball_radius"]: t.T_over_N_max for t in res.thresholds}
     assert by_r[0.015] != pytest.approx(by_r[0.025], abs=1e-4)
     for t in res.thresholds:
-        body = RodProblem.from_geometry(regime.RodGeometry(ball_radius=t.params["ball_radius"]))
+        body = RodProblem.from_geometry(RodGeometry(ball_radius=t.params["ball_radius"]))
         assert t.T_over_N_max == pytest.approx(thresholds(body, 60.0).T_over_N_max, rel=1e-12)
     th_csv = (tmp_path / "thresholds.csv").read_text().splitlines()[0].split(",")
     assert th_csv[:3] == ["theta0_deg", "ball_radius", "restitution"]

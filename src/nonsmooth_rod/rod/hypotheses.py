@@ -10,7 +10,6 @@ Both run until the axis is horizontal (ball B touches the plane: θ = 0 for equa
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass
 
 import numpy as np

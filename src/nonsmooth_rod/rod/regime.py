@@ -46,7 +46,7 @@ import numpy as np
 from ..io import dumps_json, write_csv, write_json, write_text
 from ..validation import InputError
 from .hypotheses import RollingHypothesis, rolling_hypothesis
-from .problem import RodGeometry, RodProblem
+from .problem import RodProblem
 
 SCENARIOS = ("slide-at-start", "roll-until-r1", "roll-until-r2", "roll-to-impact")
 GEOMETRY_AXES = ("ball_radius", "rod_diameter", "length", "density")
