@@ -13,6 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
+# Image formats every figure writer accepts (lossless PNG, SVG).
+IMAGE_FORMATS = ("png", "svg")
+
 _UMASK = os.umask(0)
 os.umask(_UMASK)
 

@@ -197,15 +197,13 @@ def phases_from_intervals(t_bounds, modes, min_duration: float = 0.0) -> list[Ph
     are merged into their neighbours: into the previous phase, or the next one at the start.
     """
     t_bounds = np.asarray(t_bounds, dtype=float)
-    modes = list(modes)
+    modes = np.asarray(list(modes), dtype=object)
     if len(modes) != len(t_bounds) - 1:
         raise ValueError("need one mode per interval: len(modes) == len(t_bounds) - 1")
-    phases: list[Phase] = []
-    for i, mode in enumerate(modes):
-        if phases and phases[-1].mode == mode:
-            phases[-1].t_end = t_bounds[i + 1]
-        else:
-            phases.append(Phase(mode, float(t_bounds[i]), float(t_bounds[i + 1])))
+    # Vectorised: a time-stepping run has one interval per step, a handful of phases.
+    starts = np.concatenate([[0], np.nonzero(modes[1:] != modes[:-1])[0] + 1]) if len(modes) else []
+    ends = list(starts[1:]) + [len(modes)]
+    phases = [Phase(modes[a], float(t_bounds[a]), float(t_bounds[b])) for a, b in zip(starts, ends)]
     return merge_short_phases(phases, min_duration)
 
 

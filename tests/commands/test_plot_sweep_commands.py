@@ -95,7 +95,7 @@ def test_paper_figures_without_a_folder(tmp_path):
     (["plot", "{tmp}/nowhere"], "does not exist"),
     (["plot", "{tmp}"], "trajectory.csv not found"),
     (["plot", "{ed}", "--frames", "1"], "--frames must lie in [2, 48]"),
-    (["plot", "{ed}", "--format", "jpg"], "formats must be among"),
+    (["plot", "{ed}", "--format", "jpg"], "must be among"),
     (["plot", "{ed}", "--compare", "{tmp}/nowhere"], "does not exist"),
     (["plot", "{ed}", "--no-panel"], "nothing to draw"),
     (["plot", "--paper-figures", "--gif"], "give its results folder"),
@@ -105,6 +105,21 @@ def test_paper_figures_without_a_folder(tmp_path):
     (["sweep", "--mu-s", "0.1:0.3:3", "--method", "rk4", "--out", "{tmp}/s"], "unknown method"),
     (["sweep", "--mu-s", "0.1:0.3:3", "--jobs", "0", "--out", "{tmp}/s"], "--jobs"),
     (["sweep", "--mu-s", "0.1:0.3:3", "--mu-d", "0.1", "--mu-d-ratio", "0.5"], "not allowed with"),
+    (["sweep", "--mu-s", "1:0:3", "--out", "{tmp}/s"], "runs backwards"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--mu-d", "0.3:0.1:3", "--out", "{tmp}/s"], "runs backwards"),
+    (["sweep", "--mu-s", "0.1,0.2,0.1", "--out", "{tmp}/s"], "given twice"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--format", "png,svg,png", "--out", "{tmp}/s"], "format twice"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--mu-d-ratio", "0.5:1.2:3", "--out", "{tmp}/s"], "[0, 1]"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--ball-radius", "0.01:nan:3", "--out", "{tmp}/s"], "finite"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--restitution", "0,2", "--out", "{tmp}/s"], "[0, 1]"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--executor", "spark", "--out", "{tmp}/s"], "--executor"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--scheduler", "tcp://x:1", "--out", "{tmp}/s"], "needs --executor dask"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--map-axes", "mu_s,density", "--out", "{tmp}/s"], "cannot map axis"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--check", "-1", "--out", "{tmp}/s"], "--check"),
+    (["sweep", "--mu-s", "1e308", "--out", "{tmp}/s"], "--mu-s: values must lie in [0, 100]"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--length", "1e308", "--out", "{tmp}/s"], "values must lie in (0, 100]"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--density", "1e308,7800", "--out", "{tmp}/s"], "(0, 100000]"),
+    (["sweep", "--mu-s", "0.1:0.3:3", "--ball-radius", "0.001,0.02", "--out", "{tmp}/s"], "rod diameter"),
 ])
 def test_bad_input_is_one_line_and_exit_2(runs, tmp_path, capsys, args, fragment):
     ed, _ = runs
@@ -130,7 +145,9 @@ def test_sweep_cli_writes_csv_map_and_resumes(tmp_path, capsys):
     report = capsys.readouterr().out
     assert "5 computed, 0 from an earlier run" in report and "max T/N = 0.2900" in report
     table = read_csv(out / "regime_map.csv")
-    assert list(table) == ["mu_s", "mu_d", "theta0_deg", "scenario", "t_transition", "t_impact", "phases"]
+    assert list(table) == ["mu_s", "mu_d", "theta0_deg", "scenario", "status", "t_transition", "t_impact",
+                           "theta_impact", "theta_dot_impact", "x_O_dot_impact", "phases"]
+    assert "points/s" in report and "accuracy vs event-driven" in report
     assert list(table["scenario"]) == ["slide-at-start", "slide-at-start", "roll-until-r1", "roll-until-r2",
                                        "roll-until-r2"]
     np.testing.assert_allclose(table["mu_d"], 0.7 * table["mu_s"], rtol=1e-15)
@@ -153,3 +170,28 @@ def test_sweep_over_mu_d_and_theta0_grid(tmp_path):
     got = {(r[0], r[1], r[2]): r[3] for r in zip(table["mu_s"], table["mu_d"], table["theta0_deg"], table["scenario"])}
     assert got[(0.3, 0.25, 45.0)] == "slide-at-start" and got[(0.3, 0.25, 60.0)] == "roll-until-r2"
     assert (out / "regime_map.png").exists()
+
+
+def test_sweep_cli_over_a_geometry_axis_with_the_map_axes(tmp_path, capsys):
+    out = tmp_path / "geo"
+    assert main(["sweep", "--mu-s", "0.2,0.3", "--length", "0.3,0.41", "--map-axes", "mu_s,length", "--jobs", "1",
+                 "--check", "2", "--out", str(out), "--dpi", "40"]) == 0
+    report = capsys.readouterr().out
+    assert "length = 0.3" in report and "accuracy vs event-driven" in report
+    table = read_csv(out / "regime_map.csv")
+    assert list(table)[:4] == ["mu_s", "mu_d", "theta0_deg", "length"] and len(table["mu_s"]) == 4
+    assert _png_size(out / "regime_map.png")[0] > 200
+
+
+def test_sweep_cli_on_a_dask_scheduler(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        argv = ["sweep", "--mu-s", "0.24:0.32:5", "--theta0-deg", "50,60", "--executor", "dask", "--scheduler",
+                cluster.scheduler_address, "--check", "2", "--no-plot", "--out", str(out)]
+        assert main(argv) == 0
+    report = capsys.readouterr().out
+    assert "10 computed" in report and "scenario 2/2" in report
+    table = read_csv(out / "regime_map.csv")
+    assert table["theta0_deg"].tolist() == [50.0] * 5 + [60.0] * 5

@@ -123,14 +123,21 @@ def escape(text: str) -> str:
     return rich_escape(text)
 
 
-def image_formats(text: str) -> tuple[str, ...]:
-    """Comma-separated image formats (argparse type): known ones, each once."""
-    from ..rod.plotting import FORMATS
+def parse_image_formats(text: str, option: str = "--format") -> tuple[str, ...]:
+    """Comma-separated image formats: known ones, each once (InputError naming the option)."""
+    from ..io import IMAGE_FORMATS
 
-    fmts = [f.strip().lower() for f in text.split(",") if f.strip()]
-    bad = [f for f in fmts if f not in FORMATS]
-    if not fmts or bad:
-        raise argparse.ArgumentTypeError(f"formats must be among {', '.join(FORMATS)}, got {text!r}")
+    fmts = [f.strip().lower() for f in text.split(",")]
+    if not all(fmts) or any(f not in IMAGE_FORMATS for f in fmts):
+        raise InputError(f"{option} must be among {', '.join(IMAGE_FORMATS)}, got {text!r}")
     if len(set(fmts)) != len(fmts):
-        raise argparse.ArgumentTypeError(f"each format once, got {text!r}")
+        raise InputError(f"{option} names a format twice: {text!r}")
     return tuple(fmts)
+
+
+def image_formats(text: str) -> tuple[str, ...]:
+    """`parse_image_formats` as an argparse type."""
+    try:
+        return parse_image_formats(text)
+    except InputError as err:
+        raise argparse.ArgumentTypeError(str(err).replace("--format ", "", 1)) from None

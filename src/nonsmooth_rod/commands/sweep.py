@@ -5,39 +5,61 @@ import argparse
 import copy
 import sys
 
+import numpy as np
+
 from ..validation import InputError
 
 DESCRIPTION = """\
-Classify each (μs, μd, θ0) of a grid into the paper's scenarios — slide-at-start,
-roll-until-r1 (rolling, then sliding when T/N reaches +μs), roll-until-r2 (rolling until T/N
-reaches −μs), roll-to-impact — and write DIR/regime_map.csv (mu_s,mu_d,theta0_deg,scenario,
-t_transition,t_impact,phases), DIR/thresholds.csv (the rolling hypothesis' boundaries per θ0) and
-the map DIR/regime_map.png with those boundaries. Ranges are START:STOP:N (N values, ends
-included), a,b,c or one number. Rows are appended as they finish: rerunning an interrupted
-sweep with the same --out computes only the missing points."""
+Classify each point of a grid of the rod's parameters into the paper's scenarios —
+slide-at-start, roll-until-r1 (rolling, then sliding when T/N reaches +μs), roll-until-r2
+(rolling until T/N reaches −μs), roll-to-impact — and write DIR/regime_map.csv (one column per
+axis, then scenario, status, t_transition, t_impact, the state at the impact, phases; also
+regime_map.parquet when pyarrow is installed), DIR/thresholds.csv (the rolling hypothesis'
+boundaries per θ0 and body), DIR/sweep.json (settings, grid, provenance, accuracy) and the map
+DIR/regime_map.png. Every axis takes START:STOP:N (N values, ends included), a,b,c or one
+number (then it is a fixed value, not an axis). Points run with Moreau–Jean (h = 2e-3, lemke)
+by default; a random sample is re-run with the event-driven reference and the agreement is
+reported. Rows are appended as they finish: rerunning an interrupted sweep with the same --out
+computes only the missing points."""
+
+RANGE_AXES = (("ball-radius", "ball radius r, m (default 0.020)"),
+              ("rod-diameter", "rod diameter d, m (default 0.006)"),
+              ("length", "distance between the ball centres L, m (default 0.410)"),
+              ("density", "density ρ, kg/m³ (default 7800)"),
+              ("restitution", "Newton restitution e in [0, 1] (default 0)"))
 
 
 def register(subparsers) -> None:
     from .options import add_physics_options, integer as _int, number as _float
 
-    # The shared physics options define --mu-s/--mu-d/--theta0-deg as single numbers; here they
-    # are ranges, so this parser resolves the clash in favour of the definitions below.
-    p = subparsers.add_parser("sweep", help="regime map over a grid of μs, μd, θ0",
+    # The shared physics options define the body's values as single numbers; here they are
+    # ranges, so this parser resolves the clash in favour of the definitions below.
+    p = subparsers.add_parser("sweep", help="regime map over a grid of the rod's parameters",
                               description=DESCRIPTION, conflict_handler="resolve",
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     add_physics_options(p)
-    g = p.add_argument_group("grid")
-    g.add_argument("--mu-s", default="0.05:0.5:46", help="static friction μs: START:STOP:N (default 0.05:0.5:46)")
+    g = p.add_argument_group("grid (each START:STOP:N, a,b,c or a number)")
+    g.add_argument("--mu-s", default="0.05:0.5:46", help="static friction μs (default 0.05:0.5:46)")
     mu_d = g.add_mutually_exclusive_group()
-    mu_d.add_argument("--mu-d-ratio", type=_float, default=None, help="μd = R·μs, R in [0, 1] (default 0.75)")
-    mu_d.add_argument("--mu-d", default=None, help="dynamic friction μd: START:STOP:N (points with μd > μs are skipped)")
-    g.add_argument("--theta0-deg", default="60", help="initial tilt θ0 in degrees: START:STOP:N or a number (default 60)")
-    num = p.add_argument_group("numerics and output")
-    num.add_argument("--method", default="event-driven", help="event-driven (default) or moreau-jean")
-    num.add_argument("--h", type=_float, default=1e-4, help="Moreau-Jean step size, s (default 1e-4)")
+    mu_d.add_argument("--mu-d-ratio", default=None, help="μd = R·μs, R in [0, 1] (default 0.75)")
+    mu_d.add_argument("--mu-d", default=None, help="dynamic friction μd (points with μd > μs are skipped)")
+    g.add_argument("--theta0-deg", default="60", help="initial tilt θ0 in degrees (default 60)")
+    for name, text in RANGE_AXES:
+        g.add_argument(f"--{name}", default=None, help=text)
+    num = p.add_argument_group("numerics, execution and output")
+    num.add_argument("--method", default="moreau-jean", help="moreau-jean (default) or event-driven")
+    num.add_argument("--h", type=_float, default=2e-3,
+                     help="Moreau-Jean step size, s (default 2e-3: times within 3h = 6 ms of the reference)")
     num.add_argument("--solver", default="lemke", help="Moreau-Jean one-step solver (default lemke)")
-    num.add_argument("--jobs", type=_int, default=None, help="worker processes (default: 2, or 1 on one core)")
-    num.add_argument("--out", default="sweep", help="output folder (default ./sweep); an existing sweep there is resumed")
+    num.add_argument("--check", type=_int, default=8,
+                     help="points re-run with the event-driven reference to report the accuracy (default 8)")
+    num.add_argument("--executor", default="local", help="local (a process pool, default) or dask")
+    num.add_argument("--scheduler", default=None,
+                     help="dask.distributed scheduler address (default: a LocalCluster on this machine)")
+    num.add_argument("--jobs", type=_int, default=None, help="workers (default: 2, or 1 on one core)")
+    num.add_argument("--out", default="sweep",
+                     help="output folder (default ./sweep); an existing sweep there is resumed")
+    num.add_argument("--map-axes", default=None, help="the map's two axes X,Y (default: μs and the first other axis)")
     num.add_argument("--no-plot", action="store_true", help="do not draw regime_map.png")
     num.add_argument("--format", default="png", help="comma-separated image formats: png, svg (default png)")
     num.add_argument("--dpi", type=_int, default=110, help="resolution of regime_map.png (default 110)")
@@ -45,48 +67,91 @@ def register(subparsers) -> None:
     p.set_defaults(handler=cmd_sweep)
 
 
-def cmd_sweep(args) -> int:
-    from .options import build_problem
-    from ..rod.plotting import FORMATS
-    from ..rod.regime import Grid, SweepSettings, default_jobs, parse_range, sweep
-    from ..rod.simulation import METHODS
+def _grid_and_body(args):
+    """The grid from the range options, and the options for the base body: an option with one
+    value is a fixed value of the body, not an axis."""
+    from ..rod.regime import Grid, check_axis_values, parse_range
 
+    body_args = copy.copy(args)
+    extra = {}
+    for name, _ in RANGE_AXES:
+        attr = name.replace("-", "_")
+        text = getattr(args, attr)
+        if text is None:
+            setattr(body_args, attr, 0.0 if attr == "restitution" else None)
+            continue
+        values = parse_range(text, f"--{name}", max_count=200)
+        check_axis_values(attr, values)
+        if values.size == 1:
+            setattr(body_args, attr, float(values[0]))
+        else:
+            extra[attr] = values
+            setattr(body_args, attr, float(values[0]))
     mu_s = parse_range(args.mu_s, "--mu-s")
     theta0 = parse_range(args.theta0_deg, "--theta0-deg", max_count=200)
     if args.mu_d is not None:
-        grid = Grid(mu_s, theta0, mu_d=parse_range(args.mu_d, "--mu-d"))
+        grid = Grid(mu_s, theta0, mu_d=parse_range(args.mu_d, "--mu-d"), extra=extra)
     else:
-        grid = Grid(mu_s, theta0, mu_d_ratio=0.75 if args.mu_d_ratio is None else args.mu_d_ratio)
-    n_points = len(grid.points())
-    if n_points > 200_000:
-        raise InputError(f"{n_points} grid points is too many (at most 200000)")
-    if args.method not in METHODS:
-        raise InputError(f"unknown method '{args.method}'; choose from: {', '.join(METHODS)}")
+        ratio = np.array([0.75]) if args.mu_d_ratio is None else parse_range(args.mu_d_ratio, "--mu-d-ratio")
+        grid = Grid(mu_s, theta0, mu_d_ratio=ratio, extra=extra)
+    body_args.mu_s, body_args.mu_d, body_args.theta0_deg = 0.28, 0.20, float(grid.theta0_deg[0])
+    return grid, body_args
+
+
+def _check_numerics(args) -> int:
+    from ..rod.simulation import METHODS
+
+    if args.method not in ("moreau-jean", "event-driven"):
+        known = METHODS if args.method not in METHODS else ("moreau-jean", "event-driven")
+        raise InputError(f"unknown method '{args.method}' for a sweep; choose from: {', '.join(known)}")
     if args.method == "moreau-jean":
         from ..solvers import available_solvers
         if args.solver not in available_solvers():
             raise InputError(f"unknown solver '{args.solver}'; choose from: {', '.join(available_solvers())}")
         if not 0 < args.h <= 1e-2:
             raise InputError(f"--h must lie in (0, 0.01] s, got {args.h:g}")
+    if not 0 <= args.check <= 1000:
+        raise InputError(f"--check must lie in [0, 1000], got {args.check}")
+    from ..rod.regime import default_jobs
     jobs = default_jobs() if args.jobs is None else args.jobs
     if not 1 <= jobs <= 64:
         raise InputError(f"--jobs must lie in [1, 64], got {jobs}")
-    formats = tuple(dict.fromkeys(f.strip().lower() for f in args.format.split(",") if f.strip()))
-    if not formats or any(f not in FORMATS for f in formats):
-        raise InputError(f"--format must be among {', '.join(FORMATS)}, got {args.format!r}")
+    return jobs
+
+
+def cmd_sweep(args) -> int:
+    from .options import build_problem, parse_image_formats
+    from ..rod.regime import SweepSettings, sweep
+
+    grid, body_args = _grid_and_body(args)
+    n_points = len(grid.points())
+    if n_points > 1_000_000:  # the rows are held in memory (about 1.5 kB each) for the final sort
+        raise InputError(f"{n_points} grid points is too many (at most 1000000)")
+    jobs = _check_numerics(args)
+    formats = () if args.no_plot else parse_image_formats(args.format)  # (checking them imports matplotlib)
     if not 30 <= args.dpi <= 600:
         raise InputError(f"--dpi must lie in [30, 600], got {args.dpi}")
-    # The body (and e, g) from the shared options; friction and tilt are set per grid point.
-    body_args = copy.copy(args)
-    body_args.mu_s, body_args.mu_d, body_args.theta0_deg = 0.28, 0.20, float(grid.theta0_deg[0])
+    map_axes = _map_axes_option(args.map_axes, grid)
     base = build_problem(body_args)
     settings = SweepSettings(method=args.method, h=args.h, solver=args.solver)
-    result = sweep(base, grid, args.out, settings, jobs=jobs, plot=not args.no_plot, formats=formats,
-                   dpi=args.dpi, progress=not args.quiet and sys.stderr.isatty())
+    result = sweep(base, grid, args.out, settings, jobs=jobs, executor=args.executor, scheduler=args.scheduler,
+                   plot=not args.no_plot, formats=formats, dpi=args.dpi, map_axes=map_axes,
+                   progress=not args.quiet and sys.stderr.isatty(), check_points=args.check)
     if not args.quiet:
         _report(result)
     failed = [r for r in result.grid_rows if r["scenario"] in ("failed",)]
     return 1 if failed else 0
+
+
+def _map_axes_option(text, grid) -> tuple:
+    if text is None:
+        return (None, None)
+    from ..rod.regime import _map_axes
+
+    parts = [t.strip().replace("-", "_") for t in text.split(",")]
+    if len(parts) != 2:
+        raise InputError(f"--map-axes: expected X,Y, got {text!r}")
+    return _map_axes(grid, *parts)
 
 
 def _report(result) -> None:
@@ -104,7 +169,12 @@ def _report(result) -> None:
         table.add_row(name, str(n))
     console.print(table)
     console.print(f"{result.computed} computed, {result.reused} from an earlier run")
-    for th in result.thresholds:
-        console.print(f"θ0 = {th.theta0_deg:g}°: T/N(0) = {th.T_over_N_initial:.4f}, "
+    from ..rod.regime import accuracy_text
+    rate = result.computed / max(result.compute_s, 1e-9)
+    console.print(f"{rate:,.0f} points/s ({result.compute_s:.2f} s computing, {result.wall_s:.2f} s in all)")
+    console.print(accuracy_text(result.accuracy))
+    for th in result.thresholds[:12]:
+        extra = "".join(f", {k} = {v:g}" for k, v in th.params.items())
+        console.print(f"θ0 = {th.theta0_deg:g}°{extra}: T/N(0) = {th.T_over_N_initial:.4f}, "
                       f"max T/N = {th.T_over_N_max:.4f} (t = {th.t_max:.4f} s), min T/N = {th.T_over_N_min:.4f}")
     console.print("files: " + ", ".join(str(f) for f in result.files))

@@ -1,7 +1,7 @@
 """A scene: bodies, their contacts, gravity and any other applied force."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Sequence
 
 import numpy as np

@@ -9,14 +9,14 @@ Both run until the axis is horizontal (ball B touches the plane: θ = 0 for equa
 """
 from __future__ import annotations
 
-import math
+import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import minimize_scalar
 
 from . import closed_form as cf
+
+ROLLING_CACHE_SIZE = 512  # distinct (body, θ0, g, μs) kept; a sweep group needs one each
 
 
 @dataclass
@@ -44,7 +44,41 @@ def _ratio(p, th, om):
 
 
 def rolling_hypothesis(p, n_samples: int = 2001, rtol: float = 1e-12) -> RollingHypothesis:
-    """Integrate pure rolling from rest until θ = 0 and analyse T/N."""
+    """Integrate pure rolling from rest until θ = 0 and analyse T/N.
+
+    Cached: it depends only on the body (mass, ξ, J, r), θ0, g and μs (through t_r1, t_r2), and
+    a sweep or a run summary asks for the same one many times. The result is shared between
+    callers: treat its arrays as read-only."""
+    key = (float(p.mass), float(p.xi), float(p.inertia), float(p.ball_radius), float(p.theta0), float(p.g),
+           float(p.mu_s), int(n_samples), float(rtol))
+    return _rolling_hypothesis_cached(key)
+
+
+@functools.lru_cache(maxsize=ROLLING_CACHE_SIZE)
+def _rolling_hypothesis_cached(key) -> RollingHypothesis:
+    mass, xi, inertia, ball_radius, theta0, g, mu_s, n_samples, rtol = key
+    rh = _solve_rolling(_RollingBody(mass, xi, inertia, ball_radius, theta0, g, mu_s), n_samples, rtol)
+    for arr in (rh.t, rh.theta, rh.theta_dot, rh.T_over_N):
+        arr.setflags(write=False)
+    return rh
+
+
+@dataclass(frozen=True)
+class _RollingBody:
+    """What the rolling equations read from a RodProblem (closed_form.rolling's attributes)."""
+
+    mass: float
+    xi: float
+    inertia: float
+    ball_radius: float
+    theta0: float
+    g: float
+    mu_s: float
+
+
+def _solve_rolling(p, n_samples: int, rtol: float) -> RollingHypothesis:
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import minimize_scalar
 
     def rhs(t, y):
         return [y[1], cf.rolling(p, y[0], y[1])[0]]
@@ -123,6 +157,8 @@ def _slip_direction(p, theta, theta_dot) -> float:
 
 def sliding_hypothesis(p, n_samples: int = 2001, rtol: float = 1e-12, t_max: float = 10.0) -> SlidingHypothesis:
     """Slide with μd from release, never sticking; reverse where v_C crosses zero."""
+    from scipy.integrate import solve_ivp
+
     t, y = 0.0, np.array([p.theta0, 0.0, 0.0, 0.0])  # θ, θ̇, x_O, ẋ_O
     sign = _slip_direction(p, p.theta0, 0.0)
     segments, reversals, filippov, status, t_h = [], [], [], "ok", None

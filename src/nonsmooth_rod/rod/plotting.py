@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..io import atomic_path, read_csv
+from ..io import IMAGE_FORMATS, atomic_path, read_csv
 from ..plots.frames import frame_indices  # noqa: F401  (one frame picker for every animation)
 from .problem import RodProblem
 from ..results import Phase
@@ -32,7 +32,7 @@ REGIME_WORDS = {"stick": "rolling", "slip+": "sliding (v_C > 0)", "slip-": "slid
 DATA_GID = "data"        # a run drawn as regime-coloured line pieces sharing the switch samples
 MARKER_GID = "markers"   # a compared run drawn as regime-coloured markers, pieces not overlapping
 ROLLING_GID = "rolling"  # T/N under the pure-rolling hypothesis
-FORMATS = ("png", "svg")
+FORMATS = IMAGE_FORMATS
 
 # Panels (c)–(j) of the paper's Fig. 14–16: table column (or derived series) and its axis label.
 PANEL_SERIES = (

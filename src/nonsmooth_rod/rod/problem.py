@@ -8,7 +8,7 @@ velocity of A's contact point is v_C = ẋ_O + r θ̇.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 

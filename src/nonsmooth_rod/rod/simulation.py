@@ -6,11 +6,11 @@ any integrator; this module only translates the general result into the paper's 
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..integrators.event_driven import EventDriven, EventDrivenOptions
 from .problem import RodProblem
 from ..results import Phase, SimulationResult
 from .hypotheses import RollingHypothesis, rolling_hypothesis
@@ -24,14 +24,25 @@ MAX_DURATION = 10.0  # s; without --t-end the run stops at ball B's impact, well
 
 @dataclass
 class RodRun:
+    """A run in the paper's coordinates. `table` and `rolling` are computed when first asked
+    for: a sweep point needs neither, and the rolling hypothesis (an ODE solve) would cost
+    ten times the Moreau–Jean run itself."""
+
     problem: RodProblem
     method: str
     result: SimulationResult
-    table: dict  # TRAJECTORY_COLUMNS → arrays
     phases: list[Phase]
     impact: dict | None
-    rolling: RollingHypothesis
     settings: dict = field(default_factory=dict)
+
+    @functools.cached_property
+    def table(self) -> dict:
+        """TRAJECTORY_COLUMNS → arrays."""
+        return rod_table(self.problem, self.result)
+
+    @functools.cached_property
+    def rolling(self) -> RollingHypothesis:
+        return rolling_hypothesis(self.problem)
 
     @property
     def status(self) -> str:
@@ -87,66 +98,68 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
              rtol: float | None = None, output_dt: float = 1e-3, epsilon: float = 1e-4,
              friction_curve: str = "stribeck", ode_method: str | None = None, atol: float | None = None,
              stiffness: float | None = None, damping: float | None = None,
-             time_limit: float | None = None) -> RodRun:
+             time_limit: float | None = None, max_step: float | None = None) -> RodRun:
     """Simulate the paper's rod. Without `t_end` the run stops at ball B's impact.
 
-    `rtol` defaults per method (event-driven 1e-12, regularized and switched 1e-6). The
-    baselines: "regularized" (friction curve `friction_curve` of width `epsilon`, penalty contact
-    of `stiffness`/`damping`, scipy `ode_method`, atol default rtol·1e-3) and "switched" (the
-    paper's sgn(v_C) equations, `ode_method` "rk4" with step h or an adaptive scipy method);
-    `time_limit` (wall seconds) stops either with status "time-limit".
+    The rod is a Scene run by `nonsmooth_rod.simulate` (the "switched" baseline excepted: it
+    integrates the paper's own equations of the rod). `rtol` defaults per method (event-driven
+    1e-12, regularized and switched 1e-6). The baselines: "regularized" (friction curve
+    `friction_curve` of width `epsilon`, penalty contact of `stiffness`/`damping`, scipy
+    `ode_method`, atol default rtol·1e-3) and "switched" (the paper's sgn(v_C) equations,
+    `ode_method` "rk4" with step h or an adaptive scipy method); `time_limit` (wall seconds)
+    stops either with status "time-limit"; `max_step` caps the event-driven step.
     """
     problem = problem or RodProblem.paper()
     if method not in METHODS:
         raise InputError(f"unknown method '{method}'; choose from: {', '.join(METHODS)}")
     if t_end is not None:
         require_positive("t_end", t_end)
-    stop = "B" if t_end is None else None
     duration = MAX_DURATION if t_end is None else t_end
-    scene = problem.scene()
-    q0, v0 = problem.initial_state()
-    if method == "event-driven":
-        rtol = 1e-12 if rtol is None else rtol
-        require_positive("rtol", rtol)
-        integrator = EventDriven(EventDrivenOptions(rtol=rtol, atol=rtol, stop_at_impact=stop,
-                                                    output_dt=output_dt))
-        settings = {"rtol": rtol, "output_dt": output_dt}
-    elif method == "regularized":
-        from ..integrators.regularized import Regularized, RegularizedOptions
-        rtol = 1e-6 if rtol is None else rtol
-        extra = {k: v for k, v in (("stiffness", stiffness), ("damping", damping)) if v is not None}
-        integrator = Regularized(RegularizedOptions(
-            epsilon=epsilon, friction_curve=friction_curve, ode_method=ode_method or "RK45", rtol=rtol,
-            atol=rtol * 1e-3 if atol is None else atol, stop_at_impact=stop, output_dt=output_dt,
-            time_limit=time_limit, **({"min_phase": min_phase} if min_phase is not None else {}), **extra))
-        o = integrator.options
-        settings = {"epsilon": o.epsilon, "friction_curve": o.friction_curve, "ode_method": o.ode_method,
-                    "rtol": o.rtol, "atol": o.atol, "contact_model": o.contact_model, "stiffness": o.stiffness,
-                    "damping": o.damping, "stick_velocity": o.stick_velocity, "min_phase": o.min_phase}
-    elif method == "switched":
-        from .switched import SwitchedOptions, SwitchedRod
-        rtol = 1e-6 if rtol is None else rtol
-        integrator = SwitchedRod(SwitchedOptions(
-            integrator=ode_method or "rk4", h=h, rtol=rtol, atol=rtol * 1e-3 if atol is None else atol,
-            output_dt=output_dt, time_limit=time_limit))
-        settings = {"integrator": integrator.options.integrator, "h": h, "rtol": rtol}
-    else:
-        from ..integrators.moreau_jean import MoreauJean, MoreauJeanOptions
-        integrator = MoreauJean(MoreauJeanOptions(h=h, theta=theta, solver=solver, stop_at_impact=stop,
-                                                  min_phase=min_phase))
-        settings = {"h": h, "theta": theta, "solver": solver, "min_phase": integrator.options.min_phase}
+    options, settings = _method_options(method, locals())
     if method == "switched":  # the paper's equations of the rod itself, not a scene
-        result = integrator.run(problem, duration)
+        from .switched import SwitchedOptions, SwitchedRod
+
+        result = SwitchedRod(SwitchedOptions(**options)).run(problem, duration)
     else:
-        result = integrator.run(scene, q0, v0, duration)
+        from ..driver import simulate as simulate_scene
+
+        q0, v0 = problem.initial_state()
+        result = simulate_scene(problem.scene(), q0, v0, duration, method,
+                                stop=None if t_end is not None else "B", **options)
     if t_end is None and result.status == "ok" and not any(i.contact == "B" for i in result.impacts):
-        result.status = "no-impact"
-        result.message = f"ball B did not strike the plane within {MAX_DURATION:g} s"
-    table = rod_table(problem, result)
+        result.set_status("no-impact", f"ball B did not strike the plane within {MAX_DURATION:g} s")
     phases = result.phases.get("A", [])
     phases = [Phase("flight" if p.mode == "open" else p.mode, p.t_start, p.t_end) for p in phases]
-    return RodRun(problem, method, result, table, phases, _impact_of_b(problem, result),
-                  rolling_hypothesis(problem), settings)
+    return RodRun(problem, method, result, phases, _impact_of_b(problem, result), settings)
+
+
+def _method_options(method: str, a: dict) -> tuple[dict, dict]:
+    """The method's options from simulate()'s arguments, and the settings the summary records."""
+    if method == "moreau-jean":
+        options = {"h": a["h"], "theta": a["theta"], "solver": a["solver"], "min_phase": a["min_phase"]}
+        settings = dict(options, min_phase=2 * a["h"] if a["min_phase"] is None else a["min_phase"])
+        return options, settings
+    rtol = (1e-12 if method == "event-driven" else 1e-6) if a["rtol"] is None else a["rtol"]
+    require_positive("rtol", rtol)
+    atol = (rtol if method == "event-driven" else rtol * 1e-3) if a["atol"] is None else a["atol"]
+    if method == "event-driven":
+        options = {"rtol": rtol, "atol": atol, "output_dt": a["output_dt"]}
+        if a["max_step"] is not None:
+            options["max_step"] = a["max_step"]
+        return options, dict(options)
+    if method == "switched":
+        options = {"integrator": a["ode_method"] or "rk4", "h": a["h"], "rtol": rtol, "atol": atol,
+                   "output_dt": a["output_dt"], "time_limit": a["time_limit"]}
+        return options, {"integrator": options["integrator"], "h": a["h"], "rtol": rtol}
+    options = {"epsilon": a["epsilon"], "friction_curve": a["friction_curve"], "ode_method": a["ode_method"] or "RK45",
+               "rtol": rtol, "atol": atol, "output_dt": a["output_dt"], "time_limit": a["time_limit"]}
+    options.update({k: a[k] for k in ("stiffness", "damping", "min_phase") if a[k] is not None})
+    from ..integrators.regularized import RegularizedOptions
+
+    o = RegularizedOptions(**options)
+    settings = {k: getattr(o, k) for k in ("epsilon", "friction_curve", "ode_method", "rtol", "atol", "contact_model",
+                                           "stiffness", "damping", "stick_velocity", "min_phase")}
+    return options, settings
 
 
 def scenario(phases: list[Phase]) -> str:
