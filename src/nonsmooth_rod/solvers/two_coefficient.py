@@ -25,6 +25,7 @@ import numpy as np
 
 from .. import solvers as _solvers
 from .problem import PlanarFrictionProblem, SolverError
+from .sticking import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking
 
 
 @dataclass
@@ -67,6 +68,22 @@ def classify(p: np.ndarray, u: np.ndarray, mu_s: np.ndarray, velocity_tol: float
     return states, signs, consistent
 
 
+_STATE_CODES = {"open": STATE_OPEN, "stick": STATE_STICK, "slip+": STATE_SLIP_PLUS, "slip-": STATE_SLIP_MINUS}
+_STATE_NAMES = ("open", "stick", "slip+", "slip-")
+
+
+def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, result: StepContactResult) -> None:
+    """A contact that started at rest slides only if no admissible split holds it (sticking.py):
+    replace `result` by the solution that holds the most of them, when the step has one."""
+    codes = np.array([_STATE_CODES[s] for s in result.states], dtype=np.int64)
+    p, u = np.array(result.p, dtype=float), np.array(result.u, dtype=float)
+    if prefer_sticking(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float), mu_s, mu_d,
+                       np.array(start_guess, dtype=float), float(velocity_tol), p, u, codes):
+        result.p, result.u = p, u
+        result.states = [_STATE_NAMES[c] for c in codes]
+        result.slip_signs = np.where(codes == STATE_SLIP_PLUS, 1.0, np.where(codes == STATE_SLIP_MINUS, -1.0, 0.0))
+
+
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
                           slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
                           max_solves: int = 6) -> StepContactResult:
@@ -99,6 +116,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                 ok[i] = False
         best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
         if ok.all():
+            _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, slip_guess, step_velocity_tol, best)
             return best
         # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
         # tried first); only a contact that slides even then takes the sign it slid with.
