@@ -147,7 +147,7 @@ def _attempt(W, qv, mu_s, mu_d, guess, v_tol):
     return True, p, u, st, ok_all, new_guess
 
 
-def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIVATION_ROUNDOFF):
+def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIVATION_ROUNDOFF, GAP_ROUNDOFF_ULPS):
     n_dof = q0.shape[0]
     nc = table.shape[0]
     q = np.empty((n_steps + 1, n_dof))
@@ -193,7 +193,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             predicted = gaps[i] + gamma * h * _dot(H_N[i], vk)
             margin = ACTIVATION_ROUNDOFF
             if was_closed[i]:
-                margin = h * h * (abs(drifts[i]) + abs(_dot(H_N[i], a_free)))
+                margin = max(margin, h * h * (abs(drifts[i]) + abs(_dot(H_N[i], a_free))))
             if predicted <= margin:
                 active[na] = i
                 na += 1
@@ -202,6 +202,10 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             closed_now[i] = False
         if na > 0:
             m = 2 * na
+            gap_roundoff = 1.0
+            for d in range(n_dof):
+                gap_roundoff = max(gap_roundoff, abs(qk[d]))
+            gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
             H = np.empty((m, n_dof))
             qv = np.empty(m)
             guess = np.empty(na)
@@ -212,7 +216,8 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
                 H[2 * jj] = H_N[i]
                 H[2 * jj + 1] = H_T[i]
                 if was_closed[i]:
-                    qv[2 * jj] = _dot(H_N[i], v_free) + max(gaps[i], 0.0) / h
+                    # as moreau_jean._gap_to_close: a gap of position round-off is no gap
+                    qv[2 * jj] = _dot(H_N[i], v_free) + (gaps[i] if gaps[i] > gap_roundoff else 0.0) / h
                     guess[jj] = slip_sign[i]
                 else:
                     u_n_k = _dot(H_N[i], vk)
@@ -342,8 +347,9 @@ if AVAILABLE:
 
 def run_compiled(scene, q0, v0, h, theta, gamma, n_steps, stop_index):
     """Run the compiled loop; returns the tuple of arrays of `_run`."""
-    from .moreau_jean import ACTIVATION_ROUNDOFF
+    from .moreau_jean import ACTIVATION_ROUNDOFF, GAP_ROUNDOFF_ULPS
     table = pack_contacts(scene)
     force = scene.force(0.0, np.asarray(q0, float), np.asarray(v0, float))
     return _run_jit(np.asarray(q0, float), np.asarray(v0, float), scene.inverse_mass_diagonal, force, table,
-                    float(h), float(theta), float(gamma), int(n_steps), int(stop_index), ACTIVATION_ROUNDOFF)
+                    float(h), float(theta), float(gamma), int(n_steps), int(stop_index), ACTIVATION_ROUNDOFF,
+                    GAP_ROUNDOFF_ULPS)

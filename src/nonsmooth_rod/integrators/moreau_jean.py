@@ -32,6 +32,8 @@ from ..validation import InputError, require_in_range, require_positive
 # Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
 # of a few ulps either side of zero, and must not be left out of the step for that.
 ACTIVATION_ROUNDOFF = 1e-12
+# A gap below this many ulps of the largest coordinate is round-off: not closed (_gap_to_close).
+GAP_ROUNDOFF_ULPS = 64.0
 STATE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
 STATE_NAMES = ("open", "stick", "slip+", "slip-")
 
@@ -125,6 +127,7 @@ class MoreauJean:
                 if predicted <= margin:
                     active.append(i)
             if active:
+                position_scale = max(1.0, float(np.max(np.abs(qk))))
                 H = np.empty((2 * len(active), n_dof))
                 q_step = np.empty(2 * len(active))
                 guess = np.empty(len(active))
@@ -138,7 +141,7 @@ class MoreauJean:
                         # the contact drops out and re-impacts). Asking u_N ≥ −g/h for g > 0
                         # removes the creep; a penetration (g < 0) is not pushed out, which
                         # would inject energy after every impact.
-                        q_step[2 * j] = float(c.H_N @ v_free) + _gap_to_close(c.gap) / h
+                        q_step[2 * j] = float(c.H_N @ v_free) + _gap_to_close(c.gap, position_scale) / h
                     else:
                         u_N_k = float(c.H_N @ vk)
                         q_step[2 * j] = float(c.H_N @ v_free) + rest[i] * min(u_N_k, 0.0)
@@ -289,11 +292,11 @@ class MoreauJean:
                                 steps=n_done, cpu_time_s=cpu, stats=stats)
 
 
-def _gap_to_close(gap: float) -> float:
-    """The gap a persistent contact is asked to close in one step: none below ACTIVATION_ROUNDOFF.
+def _gap_to_close(gap: float, position_scale: float) -> float:
+    """The gap a persistent contact is asked to close in one step: none if it is position round-off.
 
-    A gap of a few ulps is position round-off, not a gap; closing it within the step asks the
-    contact for a velocity round-off/h that the bodies' other contacts cannot all follow (q_step
+    A gap of a few ulps of the positions is not a gap; closing it within the step asks the
+    contact for a velocity round-off/h that the body's other contacts cannot all follow (q_step
     leaves the range of W), so a statically indeterminate body at rest would have to slip.
     """
-    return gap if gap > ACTIVATION_ROUNDOFF else 0.0
+    return gap if gap > GAP_ROUNDOFF_ULPS * np.finfo(float).eps * position_scale else 0.0
