@@ -20,7 +20,9 @@ try:
 except ImportError:  # pragma: no cover - numba is an optional accelerator
     numba = None
 
+from .. import _jit
 from ..model.contacts import DiskOnLine
+from ..solvers.sticking import prefer_sticking
 from ..solvers.lemke import CONE, INTERVAL, RESIDUAL_TOL, SOLVED, _default_max_pivots
 
 if numba is not None:
@@ -39,7 +41,8 @@ STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
 
 
 def eligible(scene, solver: str) -> bool:
-    return (AVAILABLE and solver == "lemke" and scene.applied_force is None
+    # prefer_sticking is compiled only when _jit is enabled (NONSMOOTH_ROD_NO_JIT unset)
+    return (AVAILABLE and _jit.ENABLED and solver == "lemke" and scene.applied_force is None
             and all(type(c) is DiskOnLine for c in scene.contacts) and len(scene.contacts) <= 8)
 
 
@@ -238,6 +241,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             for r_ in range(m):
                 scale_v = max(scale_v, abs(qv[r_]))
             v_tol = 1e-9 * scale_v
+            start_guess = guess.copy()
             tried = np.empty((7, na))
             n_tried = 0
             consistent = False
@@ -265,6 +269,11 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
                 break
             if not consistent:
                 inconsistent_total += 1
+            else:  # hold what μs can hold (solvers.sticking), as solve_two_coefficient
+                codes = st.astype(np.int64)
+                if prefer_sticking(W, qv, mu_s, mu_d, start_guess, v_tol, p, u, codes):
+                    for jj in range(na):
+                        st[jj] = codes[jj]
             for d in range(n_dof):
                 acc = 0.0
                 for r_ in range(m):
