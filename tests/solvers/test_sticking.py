@@ -105,3 +105,32 @@ def test_only_contacts_that_started_at_rest_are_held(start_guess, held):
         assert states[0] == STATE_STICK and abs(u[1]) < 1e-15 and p[1] == pytest.approx(-mass * v)
     else:  # a sliding contact keeps sliding while the law allows it (the sign iteration's choice)
         assert states[0] == STATE_SLIP_PLUS and u[1] > 0
+
+
+def test_interpreted_source_gives_the_compiled_split():
+    """NONSMOOTH_ROD_NO_JIT=1 runs every function of sticking.py as plain Python."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = "import json\nfrom test_sticking import wedge_split\nprint(json.dumps(wedge_split().tolist()))"
+    src = Path(__file__).resolve().parents[2] / "src"
+    env = dict(os.environ, NONSMOOTH_ROD_NO_JIT="1",
+               PYTHONPATH=os.pathsep.join([str(src), str(Path(__file__).parent)]))
+    out = subprocess.run([sys.executable, "-c", code], env=env,
+                         capture_output=True, text=True, check=True)
+    interpreted = np.array(json.loads(out.stdout.strip().splitlines()[-1]))
+    compiled = wedge_split()
+    scale = np.max(np.abs(compiled))
+    np.testing.assert_allclose(interpreted, compiled, rtol=0, atol=500 * np.finfo(float).eps * scale)
+
+
+def wedge_split():
+    """The held split of the wedged rod's first step (compiled or not, as _jit decides)."""
+    W, q = _step_problem(WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5))
+    p, u, states = _free_fall(q)
+    assert prefer_sticking(W, q, np.full(2, 0.7), np.full(2, 0.5), np.zeros(2), 1e-9 * np.max(np.abs(q)), p, u,
+                           states)
+    return p
