@@ -155,3 +155,15 @@ def test_a_held_body_and_a_sliding_body_in_one_step(solver):
     expected = -block.g * (math.sin(block.angle) - block.mu_d * math.cos(block.angle))
     np.testing.assert_allclose(np.diff(traj.v[:, 3:5] @ t) / h, expected, rtol=1e-9)
     assert set(traj.modes[1:, :2].ravel()) == {"stick"} and set(traj.modes[1:, 2:].ravel()) == {"slip-"}
+
+
+def test_quick_drift_benchmark_runs_and_every_toy_holds(capsys):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_static_indeterminacy.py"
+    spec = importlib.util.spec_from_file_location("bench_static_indeterminacy", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--quick"]) == 0
+    assert capsys.readouterr().out.count("True") == 16  # 4 toys x 4 solver runs, all stuck

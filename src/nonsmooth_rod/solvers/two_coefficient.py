@@ -15,7 +15,9 @@ the contact slid with) until the impulses obey the exact law at the end-of-step 
 
 Because stick is accepted under any guess whenever |p_T| ≤ μs p_N, a sliding contact that comes
 to rest re-sticks in the very step in which μs can hold it, whatever h is: this is what the
-naive "μd if it slid last step" rule gets wrong. See docs/friction.md.
+naive "μd if it slid last step" rule gets wrong. Once consistent, a contact that started the step
+at rest and slides is held instead if any admissible impulse split of the step can hold it
+(sticking.prefer_sticking: statically indeterminate contacts). See docs/friction.md.
 """
 from __future__ import annotations
 
