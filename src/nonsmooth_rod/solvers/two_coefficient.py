@@ -77,6 +77,8 @@ _STATE_NAMES = ("open", "stick", "slip+", "slip-")
 def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, result: StepContactResult) -> None:
     """A contact that started at rest slides only if no admissible split holds it (sticking.py):
     replace `result` by the solution that holds the most of them, when the step has one."""
+    if not any(s != "stick" and g == 0.0 for s, g in zip(result.states, start_guess)):
+        return  # no contact that started at rest moves: nothing to hold (the common step)
     codes = np.array([_STATE_CODES[s] for s in result.states], dtype=np.int64)
     p, u = np.array(result.p, dtype=float), np.array(result.u, dtype=float)
     if prefer_sticking(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float), mu_s, mu_d,
