@@ -167,3 +167,13 @@ def test_quick_drift_benchmark_runs_and_every_toy_holds(capsys):
     spec.loader.exec_module(bench)
     assert bench.main(["--quick"]) == 0
     assert capsys.readouterr().out.count("True") == 16  # 4 toys x 4 solver runs, all stuck
+
+
+@pytest.mark.skipif(not fast_moreau_jean.eligible(WedgedRod().scene(), "lemke"), reason="no compiled loop")
+def test_compiled_loop_holds_the_wedged_rod_for_1e5_steps():
+    # near its locking angle the squeeze is large, the held velocity's round-off (~4e-16 m/s)
+    # drifts the rod by ~1e-14 m, and the gap this opens must not make the step let go
+    rod = WedgedRod(angle=math.atan(0.5) - 0.01, mu_s=0.5, mu_d=0.4)
+    res = _run(rod, "lemke", 1e-3, 100_000, fast=True)
+    assert res.stats["compiled"]
+    _assert_holds(res)

@@ -65,7 +65,7 @@ def test_wedged_rod_is_held_when_some_split_can_hold_it(compiled):
     W, q = _step_problem(toy)
     p, u, states = _free_fall(q)
     mu_s, mu_d = np.full(2, 0.7), np.full(2, 0.5)
-    assert run(W, q, mu_s, mu_d, np.zeros(2), 1e-9 * np.max(np.abs(q)), p, u, states)
+    assert run(W, q, mu_s, mu_d, np.zeros(2), 1e-9 * np.max(np.abs(q)), np.zeros(2), p, u, states)
     assert list(states) == [STATE_STICK, STATE_STICK]
     np.testing.assert_allclose(u, W @ p + q, atol=1e-15)
     assert np.max(np.abs(u)) < 1e-12 * np.max(np.abs(q))  # at rest at the end of the step
@@ -80,7 +80,7 @@ def test_wedged_rod_that_no_split_can_hold_keeps_falling():
     toy = WedgedRod(angle=math.radians(30.0), mu_s=0.5, mu_d=0.4)  # tan φ = 0.577 > μs
     W, q = _step_problem(toy)
     p, u, states = _free_fall(q)
-    assert not prefer_sticking(W, q, np.full(2, 0.5), np.full(2, 0.4), np.zeros(2), 1e-12, p, u, states)
+    assert not prefer_sticking(W, q, np.full(2, 0.5), np.full(2, 0.4), np.zeros(2), 1e-12, np.zeros(2), p, u, states)
     assert np.all(p == 0) and np.all(u == q) and np.all(states == STATE_OPEN)
 
 
@@ -98,8 +98,8 @@ def test_only_contacts_that_started_at_rest_are_held(start_guess, held):
     p = np.array([mass * g * H, -mu_d * mass * g * H])  # the sliding solution
     u = W @ p + q
     states = np.array([STATE_SLIP_PLUS], dtype=np.int64)
-    changed = prefer_sticking(W, q, np.array([mu_s]), np.array([mu_d]), np.array([start_guess]), 1e-15, p, u,
-                              states)
+    changed = prefer_sticking(W, q, np.array([mu_s]), np.array([mu_d]), np.array([start_guess]), 1e-15,
+                              np.zeros(1), p, u, states)
     assert changed == held
     if held:  # a contact at rest starts sliding only when μs cannot hold it
         assert states[0] == STATE_STICK and abs(u[1]) < 1e-15 and p[1] == pytest.approx(-mass * v)
@@ -131,6 +131,23 @@ def wedge_split():
     """The held split of the wedged rod's first step (compiled or not, as _jit decides)."""
     W, q = _step_problem(WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5))
     p, u, states = _free_fall(q)
-    assert prefer_sticking(W, q, np.full(2, 0.7), np.full(2, 0.5), np.zeros(2), 1e-9 * np.max(np.abs(q)), p, u,
-                           states)
+    assert prefer_sticking(W, q, np.full(2, 0.7), np.full(2, 0.5), np.zeros(2), 1e-9 * np.max(np.abs(q)),
+                           np.zeros(2), p, u, states)
     return p
+
+
+@pytest.mark.parametrize("told", [True, False])
+def test_a_held_body_leaves_a_round_off_gap_open(told):
+    # The wedged rod has drifted 1e-13 m towards the right wall: the left contact asks to close
+    # that gap (u_N ≥ −g/h), which no squeeze can follow (W is singular); told which part of q
+    # is gap closing, the step holds the rod and leaves the gap open.
+    W, q = _step_problem(WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5))
+    closing = np.array([1e-13 / H, 0.0])
+    q[0] += closing[0]
+    p, u, states = _free_fall(q)
+    held = prefer_sticking(W, q, np.full(2, 0.7), np.full(2, 0.5), np.zeros(2), 1e-9 * np.max(np.abs(q)),
+                           closing if told else np.zeros(2), p, u, states)
+    assert held == told
+    if told:
+        assert list(states) == [STATE_STICK, STATE_STICK]
+        assert u[0] == pytest.approx(closing[0], rel=1e-6) and abs(u[2]) < 1e-15  # H_N v = 0 on both

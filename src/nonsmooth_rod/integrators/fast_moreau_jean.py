@@ -212,6 +212,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             H = np.empty((m, n_dof))
             qv = np.empty(m)
             guess = np.empty(na)
+            closing = np.zeros(na)
             mu_s = np.empty(na)
             mu_d = np.empty(na)
             for jj in range(na):
@@ -220,7 +221,8 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
                 H[2 * jj + 1] = H_T[i]
                 if was_closed[i]:
                     # as moreau_jean._gap_to_close: a gap of position round-off is no gap
-                    qv[2 * jj] = _dot(H_N[i], v_free) + (gaps[i] if gaps[i] > gap_roundoff else 0.0) / h
+                    closing[jj] = (gaps[i] if gaps[i] > gap_roundoff else 0.0) / h
+                    qv[2 * jj] = _dot(H_N[i], v_free) + closing[jj]
                     guess[jj] = slip_sign[i]
                 else:
                     u_n_k = _dot(H_N[i], vk)
@@ -271,7 +273,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
                 inconsistent_total += 1
             else:  # hold what μs can hold (solvers.sticking), as solve_two_coefficient
                 codes = st.astype(np.int64)
-                if prefer_sticking(W, qv, mu_s, mu_d, start_guess, v_tol, p, u, codes):
+                if prefer_sticking(W, qv, mu_s, mu_d, start_guess, v_tol, closing, p, u, codes):
                     for jj in range(na):
                         st[jj] = codes[jj]
             for d in range(n_dof):

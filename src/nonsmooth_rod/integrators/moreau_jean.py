@@ -131,6 +131,7 @@ class MoreauJean:
                 H = np.empty((2 * len(active), n_dof))
                 q_step = np.empty(2 * len(active))
                 guess = np.empty(len(active))
+                closing = np.zeros(len(active))
                 for j, i in enumerate(active):
                     c = kin[i]
                     H[2 * j], H[2 * j + 1] = c.H_N, c.H_T
@@ -141,7 +142,8 @@ class MoreauJean:
                         # the contact drops out and re-impacts). Asking u_N ≥ −g/h for g > 0
                         # removes the creep; a penetration (g < 0) is not pushed out, which
                         # would inject energy after every impact.
-                        q_step[2 * j] = float(c.H_N @ v_free) + _gap_to_close(c.gap, position_scale) / h
+                        closing[j] = _gap_to_close(c.gap, position_scale) / h
+                        q_step[2 * j] = float(c.H_N @ v_free) + closing[j]
                     else:
                         u_N_k = float(c.H_N @ vk)
                         q_step[2 * j] = float(c.H_N @ v_free) + rest[i] * min(u_N_k, 0.0)
@@ -155,7 +157,7 @@ class MoreauJean:
                 a_idx = np.array(active)
                 try:
                     res = solve_two_coefficient(W, q_step, mu_s[a_idx], mu_d[a_idx], guess,
-                                                opts.solver, opts.solver_options)
+                                                opts.solver, opts.solver_options, closing=closing)
                 except SolverError as err:
                     state_txt = ", ".join(f"{names[i]}:{STATE_NAMES[states[k - 1, i]] if k else 'initial'}"
                                           for i in range(nc))

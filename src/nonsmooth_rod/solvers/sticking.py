@@ -291,14 +291,16 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
 
 
 @jit
-def _sliding_from_rest(start_guess, u, states, velocity_tol, candidates):
-    """Contacts that started the step at rest (guess 0), touch at its end (u_N = 0) and slide:
-    they must be held if any admissible split can hold them. Returns how many (≤ MAX_CANDIDATES)."""
+def _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates):
+    """Contacts that started the step at rest (guess 0), touch at its end (u_N = 0, or u_N equal to
+    the gap-closing velocity) and slide: they must be held if any admissible split can hold them.
+    Returns how many (≤ MAX_CANDIDATES)."""
     n = 0
     for i in range(start_guess.shape[0]):
         if n == MAX_CANDIDATES:
             break
-        if states[i] != STATE_STICK and start_guess[i] == 0.0 and abs(u[2 * i]) <= velocity_tol \
+        touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
+        if states[i] != STATE_STICK and start_guess[i] == 0.0 and touching \
                 and abs(u[2 * i + 1]) > velocity_tol:
             candidates[n] = i
             n += 1
@@ -352,19 +354,31 @@ def _write_solution(W, q, mode, p_new, velocity_tol, p, u, states):
 
 
 @jit
-def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, p, u, states):
+def _without_gap_closing(q, closing, mode, q_held):
+    """q with the gap-closing part of the normal rows of closed contacts removed: a held body
+    does not chase gaps of position round-off (they need not be mutually consistent)."""
+    q_held[:] = q
+    for i in range(mode.shape[0]):
+        if mode[i] != MODE_OPEN:
+            q_held[2 * i] -= closing[i]
+
+
+@jit
+def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
     """Hold what μs can hold: if another admissible solution of the step u = W p + q keeps more of
     the contacts that started at rest sticking, overwrite p, u, states in place; return True then.
 
     W (m×m), q (m,), p, u (m,) float64 with m = 2 na ordered (N, T) per contact; mu_s, mu_d,
     start_guess (na,) float64 — start_guess is the slip guess the step STARTED from (0 at rest,
     ±1 sliding), not the converged one; velocity_tol: the velocity below which a slip is zero
-    (the sign iteration's); states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
+    (the sign iteration's); closing (na,) float64: the part g/h of q_N that asks a persistent
+    contact to close an open gap (0 if none) — a held mode may instead leave it open;
+    states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
     The largest held set wins (ties: the first in contact order); at most MAX_TRIALS tries.
     """
     na = mu_s.shape[0]
     candidates = np.empty(na, dtype=np.int64)
-    n_c = _sliding_from_rest(start_guess, u, states, velocity_tol, candidates)
+    n_c = _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates)
     if n_c == 0:
         return False
     w_max = max(1e-300, np.max(np.abs(W)))
@@ -374,6 +388,8 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, p, u, states):
     mode = np.zeros(na, dtype=np.int64)
     sign = np.zeros(na)
     p_new = np.zeros(2 * na)
+    q_held = np.empty(2 * na)
+    chases_gaps = np.max(closing) > 0.0
     trials = 0
     for size in range(n_c, 0, -1):
         for held in range(1, 1 << n_c):
@@ -383,7 +399,11 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, p, u, states):
                 return False
             trials += 1
             _modes_for(held, candidates, n_c, u, states, mode, sign)
-            if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+            admissible = admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+            if not admissible and chases_gaps:
+                _without_gap_closing(q, closing, mode, q_held)
+                admissible = admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+            if admissible:
                 _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
                 return True
     return False

@@ -74,7 +74,8 @@ _STATE_CODES = {"open": STATE_OPEN, "stick": STATE_STICK, "slip+": STATE_SLIP_PL
 _STATE_NAMES = ("open", "stick", "slip+", "slip-")
 
 
-def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, result: StepContactResult) -> None:
+def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, closing,
+                             result: StepContactResult) -> None:
     """A contact that started at rest slides only if no admissible split holds it (sticking.py):
     replace `result` by the solution that holds the most of them, when the step has one."""
     if not any(s != "stick" and g == 0.0 for s, g in zip(result.states, start_guess)):
@@ -82,7 +83,7 @@ def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, result
     codes = np.array([_STATE_CODES[s] for s in result.states], dtype=np.int64)
     p, u = np.array(result.p, dtype=float), np.array(result.u, dtype=float)
     if prefer_sticking(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float), mu_s, mu_d,
-                       np.array(start_guess, dtype=float), float(velocity_tol), p, u, codes):
+                       np.array(start_guess, dtype=float), float(velocity_tol), closing, p, u, codes):
         result.p, result.u = p, u
         result.states = [_STATE_NAMES[c] for c in codes]
         result.slip_signs = np.where(codes == STATE_SLIP_PLUS, 1.0, np.where(codes == STATE_SLIP_MINUS, -1.0, 0.0))
@@ -90,8 +91,11 @@ def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, result
 
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
                           slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
-                          max_solves: int = 6) -> StepContactResult:
-    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`."""
+                          max_solves: int = 6, closing: np.ndarray | None = None) -> StepContactResult:
+    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`.
+
+    `closing` (per contact, default 0): the gap-closing velocity g/h included in q_N, which a
+    held statically indeterminate body may leave unclosed (sticking.prefer_sticking)."""
     mu_s = np.asarray(mu_s, dtype=float)
     mu_d = np.asarray(mu_d, dtype=float)
     guess = np.array(slip_guess, dtype=float)
@@ -120,7 +124,8 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                 ok[i] = False
         best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
         if ok.all():
-            _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, slip_guess, step_velocity_tol, best)
+            closing = np.zeros(len(mu_s)) if closing is None else np.asarray(closing, dtype=float)
+            _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, slip_guess, step_velocity_tol, closing, best)
             return best
         # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
         # tried first); only a contact that slides even then takes the sign it slid with.
