@@ -34,6 +34,7 @@ from ..validation import InputError, require_in_range, require_positive
 ACTIVATION_ROUNDOFF = 1e-12
 # A gap below this many ulps of the largest coordinate is round-off: not closed (_gap_to_close).
 GAP_ROUNDOFF_ULPS = 64.0
+GAP_ROUNDOFF = GAP_ROUNDOFF_ULPS * float(np.finfo(float).eps)
 STATE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
 STATE_NAMES = ("open", "stick", "slip+", "slip-")
 
@@ -127,7 +128,7 @@ class MoreauJean:
                 if predicted <= margin:
                     active.append(i)
             if active:
-                position_scale = max(1.0, float(np.max(np.abs(qk))))
+                position_scale = max(1.0, max(map(abs, qk.tolist())))  # plain floats: per step
                 H = np.empty((2 * len(active), n_dof))
                 q_step = np.empty(2 * len(active))
                 guess = np.empty(len(active))
@@ -301,4 +302,4 @@ def _gap_to_close(gap: float, position_scale: float) -> float:
     contact for a velocity round-off/h that the body's other contacts cannot all follow (q_step
     leaves the range of W), so a statically indeterminate body at rest would have to slip.
     """
-    return gap if gap > GAP_ROUNDOFF_ULPS * np.finfo(float).eps * position_scale else 0.0
+    return gap if gap > GAP_ROUNDOFF * position_scale else 0.0

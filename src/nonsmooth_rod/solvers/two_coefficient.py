@@ -80,6 +80,7 @@ def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, closin
     replace `result` by the solution that holds the most of them, when the step has one."""
     if not any(s != "stick" and g == 0.0 for s, g in zip(result.states, start_guess)):
         return  # no contact that started at rest moves: nothing to hold (the common step)
+    closing = np.zeros(len(mu_s)) if closing is None else np.asarray(closing, dtype=float)
     codes = np.array([_STATE_CODES[s] for s in result.states], dtype=np.int64)
     p, u = np.array(result.p, dtype=float), np.array(result.u, dtype=float)
     if prefer_sticking(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float), mu_s, mu_d,
@@ -124,7 +125,6 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                 ok[i] = False
         best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
         if ok.all():
-            closing = np.zeros(len(mu_s)) if closing is None else np.asarray(closing, dtype=float)
             _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, slip_guess, step_velocity_tol, closing, best)
             return best
         # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
