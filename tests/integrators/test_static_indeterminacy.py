@@ -177,3 +177,11 @@ def test_compiled_loop_holds_the_wedged_rod_for_1e5_steps():
     res = _run(rod, "lemke", 1e-3, 100_000, fast=True)
     assert res.stats["compiled"]
     _assert_holds(res)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_the_ladder_of_issue_14_holds(solver):
+    # floor μs 0.3 / μd 0.24, wall 0.1 / 0.08, β = 60° ≥ 58.3°: it used to slide 2.5 cm in 0.3 s
+    ladder = Ladder()
+    assert ladder.angle == pytest.approx(math.radians(60.0)) and math.degrees(ladder.critical_angle()) < 58.3
+    _assert_holds(_run(ladder, solver, 1e-4, 3000))
