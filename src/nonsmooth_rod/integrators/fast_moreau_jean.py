@@ -20,7 +20,9 @@ try:
 except ImportError:  # pragma: no cover - numba is an optional accelerator
     numba = None
 
+from .. import _jit
 from ..model.contacts import DiskOnLine
+from ..solvers.sticking import prefer_sticking
 from ..solvers.lemke import CONE, INTERVAL, RESIDUAL_TOL, SOLVED, _default_max_pivots
 
 if numba is not None:
@@ -39,7 +41,8 @@ STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
 
 
 def eligible(scene, solver: str) -> bool:
-    return (AVAILABLE and solver == "lemke" and scene.applied_force is None
+    # prefer_sticking is compiled only when _jit is enabled (NONSMOOTH_ROD_NO_JIT unset)
+    return (AVAILABLE and _jit.ENABLED and solver == "lemke" and scene.applied_force is None
             and all(type(c) is DiskOnLine for c in scene.contacts) and len(scene.contacts) <= 8)
 
 
@@ -147,7 +150,7 @@ def _attempt(W, qv, mu_s, mu_d, guess, v_tol):
     return True, p, u, st, ok_all, new_guess
 
 
-def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIVATION_ROUNDOFF):
+def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIVATION_ROUNDOFF, GAP_ROUNDOFF_ULPS):
     n_dof = q0.shape[0]
     nc = table.shape[0]
     q = np.empty((n_steps + 1, n_dof))
@@ -193,7 +196,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             predicted = gaps[i] + gamma * h * _dot(H_N[i], vk)
             margin = ACTIVATION_ROUNDOFF
             if was_closed[i]:
-                margin = h * h * (abs(drifts[i]) + abs(_dot(H_N[i], a_free)))
+                margin = max(margin, h * h * (abs(drifts[i]) + abs(_dot(H_N[i], a_free))))
             if predicted <= margin:
                 active[na] = i
                 na += 1
@@ -202,9 +205,14 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             closed_now[i] = False
         if na > 0:
             m = 2 * na
+            gap_roundoff = 1.0
+            for d in range(n_dof):
+                gap_roundoff = max(gap_roundoff, abs(qk[d]))
+            gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
             H = np.empty((m, n_dof))
             qv = np.empty(m)
             guess = np.empty(na)
+            closing = np.zeros(na)
             mu_s = np.empty(na)
             mu_d = np.empty(na)
             for jj in range(na):
@@ -212,7 +220,9 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
                 H[2 * jj] = H_N[i]
                 H[2 * jj + 1] = H_T[i]
                 if was_closed[i]:
-                    qv[2 * jj] = _dot(H_N[i], v_free) + max(gaps[i], 0.0) / h
+                    # as moreau_jean._gap_to_close: a gap of position round-off is no gap
+                    closing[jj] = (gaps[i] if gaps[i] > gap_roundoff else 0.0) / h
+                    qv[2 * jj] = _dot(H_N[i], v_free) + closing[jj]
                     guess[jj] = slip_sign[i]
                 else:
                     u_n_k = _dot(H_N[i], vk)
@@ -233,6 +243,7 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
             for r_ in range(m):
                 scale_v = max(scale_v, abs(qv[r_]))
             v_tol = 1e-9 * scale_v
+            start_guess = guess.copy()
             tried = np.empty((7, na))
             n_tried = 0
             consistent = False
@@ -260,6 +271,11 @@ def _run(q0, v0, minv, force, table, h, theta, gamma, n_steps, stop_index, ACTIV
                 break
             if not consistent:
                 inconsistent_total += 1
+            else:  # hold what μs can hold (solvers.sticking), as solve_two_coefficient
+                codes = st.astype(np.int64)
+                if prefer_sticking(W, qv, mu_s, mu_d, start_guess, v_tol, closing, p, u, codes):
+                    for jj in range(na):
+                        st[jj] = codes[jj]
             for d in range(n_dof):
                 acc = 0.0
                 for r_ in range(m):
@@ -342,8 +358,9 @@ if AVAILABLE:
 
 def run_compiled(scene, q0, v0, h, theta, gamma, n_steps, stop_index):
     """Run the compiled loop; returns the tuple of arrays of `_run`."""
-    from .moreau_jean import ACTIVATION_ROUNDOFF
+    from .moreau_jean import ACTIVATION_ROUNDOFF, GAP_ROUNDOFF_ULPS
     table = pack_contacts(scene)
     force = scene.force(0.0, np.asarray(q0, float), np.asarray(v0, float))
     return _run_jit(np.asarray(q0, float), np.asarray(v0, float), scene.inverse_mass_diagonal, force, table,
-                    float(h), float(theta), float(gamma), int(n_steps), int(stop_index), ACTIVATION_ROUNDOFF)
+                    float(h), float(theta), float(gamma), int(n_steps), int(stop_index), ACTIVATION_ROUNDOFF,
+                    GAP_ROUNDOFF_ULPS)

@@ -15,7 +15,9 @@ the contact slid with) until the impulses obey the exact law at the end-of-step 
 
 Because stick is accepted under any guess whenever |p_T| ≤ μs p_N, a sliding contact that comes
 to rest re-sticks in the very step in which μs can hold it, whatever h is: this is what the
-naive "μd if it slid last step" rule gets wrong. See docs/friction.md.
+naive "μd if it slid last step" rule gets wrong. Once consistent, a contact that started the step
+at rest and slides is held instead if any admissible impulse split of the step can hold it
+(sticking.prefer_sticking: statically indeterminate contacts). See docs/friction.md.
 """
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ import numpy as np
 
 from .. import solvers as _solvers
 from .problem import PlanarFrictionProblem, SolverError
+from .sticking import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking
 
 
 @dataclass
@@ -67,10 +70,33 @@ def classify(p: np.ndarray, u: np.ndarray, mu_s: np.ndarray, velocity_tol: float
     return states, signs, consistent
 
 
+_STATE_CODES = {"open": STATE_OPEN, "stick": STATE_STICK, "slip+": STATE_SLIP_PLUS, "slip-": STATE_SLIP_MINUS}
+_STATE_NAMES = ("open", "stick", "slip+", "slip-")
+
+
+def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, closing,
+                             result: StepContactResult) -> None:
+    """A contact that started at rest slides only if no admissible split holds it (sticking.py):
+    replace `result` by the solution that holds the most of them, when the step has one."""
+    if not any(s != "stick" and g == 0.0 for s, g in zip(result.states, start_guess)):
+        return  # no contact that started at rest moves: nothing to hold (the common step)
+    closing = np.zeros(len(mu_s)) if closing is None else np.asarray(closing, dtype=float)
+    codes = np.array([_STATE_CODES[s] for s in result.states], dtype=np.int64)
+    p, u = np.array(result.p, dtype=float), np.array(result.u, dtype=float)
+    if prefer_sticking(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float), mu_s, mu_d,
+                       np.array(start_guess, dtype=float), float(velocity_tol), closing, p, u, codes):
+        result.p, result.u = p, u
+        result.states = [_STATE_NAMES[c] for c in codes]
+        result.slip_signs = np.where(codes == STATE_SLIP_PLUS, 1.0, np.where(codes == STATE_SLIP_MINUS, -1.0, 0.0))
+
+
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
                           slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
-                          max_solves: int = 6) -> StepContactResult:
-    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`."""
+                          max_solves: int = 6, closing: np.ndarray | None = None) -> StepContactResult:
+    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`.
+
+    `closing` (per contact, default 0): the gap-closing velocity g/h included in q_N, which a
+    held statically indeterminate body may leave unclosed (sticking.prefer_sticking)."""
     mu_s = np.asarray(mu_s, dtype=float)
     mu_d = np.asarray(mu_d, dtype=float)
     guess = np.array(slip_guess, dtype=float)
@@ -99,6 +125,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                 ok[i] = False
         best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
         if ok.all():
+            _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, slip_guess, step_velocity_tol, closing, best)
             return best
         # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
         # tried first); only a contact that slides even then takes the sign it slid with.

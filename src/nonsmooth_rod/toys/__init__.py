@@ -25,6 +25,7 @@ from .bouncing_ball import BouncingBall, ball_height, rest_time
 from .collisions import BallRow, ball_velocities
 from .common import example_parser, first_slip_time, run, save_figure
 from .disk import DiskOnIncline
+from .indeterminate import DiskPyramid, Ladder, WedgedRod
 from .painleve import PainleveRod
 from .rocking_block import RockingBlock, impact_rate_pairs
 
@@ -32,5 +33,5 @@ __all__ = [
     "run", "BouncingBall", "BlockOnIncline", "PushedBlock", "DiskOnIncline", "BeltOscillator",
     "RockingBlock", "PainleveRod", "BallRow", "ball_height", "rest_time", "slope_motion",
     "first_slip_time", "stick_slip_phases", "impact_rate_pairs", "ball_velocities", "save_figure",
-    "example_parser",
+    "example_parser", "Ladder", "WedgedRod", "DiskPyramid",
 ]

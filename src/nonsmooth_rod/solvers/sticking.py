@@ -1,0 +1,413 @@
+"""Sticking preference of the Moreau–Jean step: a contact slides only if no admissible split holds it.
+
+Two or more contacts on one body make the step statically indeterminate: the Delassus matrix W is
+singular, the end-of-step velocities of a mode (which contacts stick, which slide which way) are
+unique, but the impulses are not — any split p + Z z with Z spanning the null space of the
+mode's equations gives the same motion. An LCP solver returns one vertex of that set, and with
+it possibly a sliding solution although another admissible split would keep the contact at rest.
+
+`prefer_sticking` runs after the two-coefficient sign iteration has a consistent solution. For
+the contacts that started the step at rest (start guess 0), touch (u_N = 0) and slide, it asks the
+event-driven integrator's question at impulse level (`model.dynamics._most_admissible_split`):
+is there a split of the step's impulses that keeps them sticking, every other closed contact in
+its state (sticking ones inside the μs cone, sliding ones on the μd line with their slip
+direction kept), open contacts open, and normal complementarity everywhere? The largest such
+set of held contacts wins; the split chosen is the one deepest inside every cone (maximal
+smallest margin min(p_N, μs p_N − |p_T|)), found by a small dense simplex. See docs/friction.md.
+
+Plain arrays and int64 state codes only, decorated with `_jit.jit`: the same source runs
+compiled inside a numba loop and interpreted.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import jit
+
+STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
+MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
+MAX_CANDIDATES = 16  # contacts considered for a held set (beyond: the first 16)
+MAX_TRIALS = 64  # feasibility problems per step at most
+SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driven LP
+PIVOT_TOL = 1e-11
+RANK_TOL = 1e-10  # singular values below RANK_TOL × the largest span the indeterminate splits
+MARGIN_TOL = 1e-9  # a cone margin above −MARGIN_TOL × the impulse scale is admissible
+
+
+@jit
+def _pivot(T, basis, r, j):
+    """Gauss–Jordan pivot of tableau T on (r, j): variable j enters the basis in row r."""
+    T[r, :] /= T[r, j]
+    for i in range(T.shape[0]):
+        if i != r and T[i, j] != 0.0:
+            T[i, :] -= T[i, j] * T[r, :]
+    basis[r] = j
+
+
+@jit
+def _set_objective(T, basis, cost):
+    """Objective row of T: reduced costs cost_j − c_Bᵀ T[:, j] (last entry −objective value)."""
+    m = T.shape[0] - 1
+    T[m, :] = 0.0
+    T[m, : cost.shape[0]] = cost
+    for i in range(m):
+        cb = cost[basis[i]]
+        if cb != 0.0:
+            T[m, :] -= cb * T[i, :]
+
+
+@jit
+def _run_simplex(T, basis, n_allowed, max_iter):
+    """Maximise over the tableau with Bland's rule; columns ≥ n_allowed never enter.
+    Returns 0 optimal, 1 unbounded, 2 iteration limit."""
+    m = T.shape[0] - 1
+    rhs = T.shape[1] - 1
+    for _ in range(max_iter):
+        j = -1
+        for col in range(n_allowed):
+            if T[m, col] > PIVOT_TOL:
+                j = col
+                break
+        if j < 0:
+            return 0
+        r = -1
+        best = np.inf
+        for i in range(m):
+            if T[i, j] > PIVOT_TOL:
+                ratio = T[i, rhs] / T[i, j]
+                if ratio < best - 1e-14 or (ratio <= best + 1e-14 and r >= 0 and basis[i] < basis[r]):
+                    best = ratio
+                    r = i
+        if r < 0:
+            return 1
+        _pivot(T, basis, r, j)
+    return 2
+
+
+@jit
+def simplex_max(c, G, h, x):
+    """max cᵀx subject to G x ≤ h, x ≥ 0 (dense two-phase simplex, Bland's rule).
+
+    Phase 1 adds one auxiliary variable x_a (G x − x_a ≤ h, max −x_a) entered at the most
+    violated row. Fills x; returns 0 optimal, 1 unbounded, 2 iteration limit, 3 infeasible.
+    """
+    m, n = G.shape
+    T = np.zeros((m + 1, n + m + 2))
+    basis = np.empty(m, dtype=np.int64)
+    for i in range(m):
+        T[i, :n] = G[i, :]
+        T[i, n] = -1.0
+        T[i, n + 1 + i] = 1.0
+        T[i, -1] = h[i]
+        basis[i] = n + 1 + i
+    max_iter = 50 * (n + m + 2)
+    worst = 0
+    for i in range(m):
+        if h[i] < h[worst]:
+            worst = i
+    cost = np.zeros(n + m + 1)
+    if m > 0 and h[worst] < 0.0:
+        cost[n] = -1.0
+        _pivot(T, basis, worst, n)
+        _set_objective(T, basis, cost)
+        if _run_simplex(T, basis, n + m + 1, max_iter) != 0 or -T[m, -1] < -1e-10 * (1.0 + np.max(np.abs(h))):
+            return 3
+        for i in range(m):
+            if basis[i] == n:  # degenerate: x_a = 0 basic; swap it for any usable column
+                for j in range(n + m + 1):
+                    if j != n and abs(T[i, j]) > PIVOT_TOL:
+                        _pivot(T, basis, i, j)
+                        break
+        cost[n] = 0.0
+    T[:, n] = 0.0  # the auxiliary variable is done with (or was never needed)
+    cost[:n] = c
+    _set_objective(T, basis, cost)
+    status = _run_simplex(T, basis, n + m + 1, max_iter)
+    x[:] = 0.0
+    for i in range(m):
+        if basis[i] < n:
+            x[basis[i]] = T[i, -1]
+    return status
+
+
+@jit
+def _unknowns(mode, sign, mu_d):
+    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking ones; a
+    sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode (u_N = 0 of closed
+    contacts, u_T = 0 of sticking ones)."""
+    na = mode.shape[0]
+    n_x = 0
+    for i in range(na):
+        n_x += 2 if mode[i] == MODE_STICK else (1 if mode[i] == MODE_SLIDE else 0)
+    P = np.zeros((2 * na, n_x))
+    rows = np.empty(n_x, dtype=np.int64)
+    k = 0
+    for i in range(na):
+        if mode[i] == MODE_OPEN:
+            continue
+        P[2 * i, k] = 1.0
+        rows[k] = 2 * i
+        if mode[i] == MODE_STICK:
+            P[2 * i + 1, k + 1] = 1.0
+            rows[k + 1] = 2 * i + 1
+            k += 2
+        else:
+            P[2 * i + 1, k] = -mu_d[i] * sign[i]
+            k += 1
+    return P, rows
+
+
+@jit
+def _particular_and_null(A, b):
+    """Least-squares x0 of A x = b (minimum norm) and an orthonormal basis Z of the null space of A."""
+    U, s, Vt = np.linalg.svd(A)
+    n = A.shape[1]
+    rank = 0
+    for i in range(s.shape[0]):
+        if s[i] > RANK_TOL * s[0]:
+            rank += 1
+    x0 = np.zeros(n)
+    for i in range(rank):
+        coef = 0.0
+        for r in range(A.shape[0]):
+            coef += U[r, i] * b[r]
+        x0 += (coef / s[i]) * Vt[i, :]
+    Z = np.ascontiguousarray(Vt[rank:, :].T)
+    return x0, Z
+
+
+@jit
+def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale):
+    """Rows (G, h, weight) of  g0 + g·z ≥ weight·t  for every law the split must keep, in
+    impulse units divided by `scale`: p_N ≥ t and μs p_N ∓ p_T ≥ t (weight 1, the margins);
+    slip direction kept s u_T ≥ −tol and open contacts u_N ≥ −tol (weight 0, hard)."""
+    na = mode.shape[0]
+    k = Pz.shape[1]
+    u0 = W @ p0 + q
+    Wz = W @ Pz
+    w_scale = max(1e-300, np.max(np.abs(W)))
+    G = np.zeros((3 * na, k))
+    h = np.zeros(3 * na)
+    weight = np.zeros(3 * na)
+    n = 0
+    for i in range(na):
+        if mode[i] == MODE_OPEN:  # velocities in impulse units: divided by max|W|
+            G[n] = Wz[2 * i] / w_scale
+            h[n] = (u0[2 * i] + velocity_tol) / w_scale
+            n += 1
+            continue
+        G[n] = Pz[2 * i]
+        h[n] = p0[2 * i]
+        weight[n] = 1.0
+        n += 1
+        if mode[i] == MODE_STICK:
+            for side in (-1.0, 1.0):
+                G[n] = mu_s[i] * Pz[2 * i] + side * Pz[2 * i + 1]
+                h[n] = mu_s[i] * p0[2 * i] + side * p0[2 * i + 1]
+                weight[n] = 1.0
+                n += 1
+        else:
+            G[n] = sign[i] * Wz[2 * i + 1] / w_scale
+            h[n] = (sign[i] * u0[2 * i + 1] + velocity_tol) / w_scale
+            n += 1
+    return G[:n] / scale, h[:n] / scale, weight[:n]
+
+
+@jit
+def _deepest_split(G, h, weight, z):
+    """max t subject to g0 + g·z ≥ weight·t, |z| ≤ SPLIT_BOUND, t ≤ 1 (z, t free; scaled units).
+    Fills z and returns t (−inf when even the hard rows cannot hold)."""
+    m, k = G.shape
+    n = 2 * k + 2  # z = z⁺ − z⁻, t = t⁺ − t⁻
+    Glp = np.zeros((m + 2 * k + 1, n))
+    hlp = np.zeros(m + 2 * k + 1)
+    for r in range(m):  # −g·z + weight·t ≤ g0
+        Glp[r, :k] = -G[r]
+        Glp[r, k : 2 * k] = G[r]
+        Glp[r, 2 * k] = weight[r]
+        Glp[r, 2 * k + 1] = -weight[r]
+        hlp[r] = h[r]
+    for j in range(k):
+        Glp[m + 2 * j, j] = 1.0
+        Glp[m + 2 * j + 1, k + j] = 1.0
+        hlp[m + 2 * j] = SPLIT_BOUND
+        hlp[m + 2 * j + 1] = SPLIT_BOUND
+    Glp[m + 2 * k, 2 * k] = 1.0
+    Glp[m + 2 * k, 2 * k + 1] = -1.0
+    hlp[m + 2 * k] = 1.0
+    c = np.zeros(n)
+    c[2 * k] = 1.0
+    c[2 * k + 1] = -1.0
+    x = np.zeros(n)
+    if simplex_max(c, Glp, hlp, x) != 0:
+        return -np.inf
+    z[:] = x[:k] - x[k : 2 * k]
+    return x[2 * k] - x[2 * k + 1]
+
+
+@jit
+def _split_obeys_law(W, q, mode, sign, mu_s, p, u, velocity_tol, scale):
+    """Does p (with u = W p + q) obey the mode within the tolerances? The final check, so that a
+    split found along a nearly-null direction is never accepted on the LP's word alone."""
+    p_tol = MARGIN_TOL * scale
+    for i in range(mode.shape[0]):
+        pn, pt, un, ut = p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1]
+        if mode[i] == MODE_OPEN:
+            if un < -velocity_tol:
+                return False
+            continue
+        if pn < -p_tol or abs(un) > velocity_tol:
+            return False
+        if mode[i] == MODE_STICK:
+            if abs(ut) > velocity_tol or abs(pt) > mu_s[i] * pn + p_tol:
+                return False
+        elif sign[i] * ut < -velocity_tol:
+            return False
+    return True
+
+
+@jit
+def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
+    """The split of the step's impulses deepest inside every cone that keeps each contact in its
+    mode (MODE_OPEN / MODE_STICK / MODE_SLIDE with slip sign `sign`), with normal
+    complementarity (closed: u_N = 0, p_N ≥ 0; open: p = 0, u_N ≥ 0). Fills p_out and returns
+    True when one exists within the tolerances, False otherwise (p_out then undefined)."""
+    P, rows = _unknowns(mode, sign, mu_d)
+    if P.shape[1] == 0:
+        return False
+    A = np.ascontiguousarray((W @ P)[rows, :])
+    b = -q[rows]
+    x0, Z = _particular_and_null(A, b)
+    p0 = P @ x0
+    Pz = np.ascontiguousarray(P @ Z)
+    z = np.zeros(Z.shape[1])
+    G, h, weight = _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
+    margin = _deepest_split(G, h, weight, z)
+    if margin < -MARGIN_TOL:
+        return False
+    p_out[:] = p0 + Pz @ z
+    u = W @ p_out + q
+    return _split_obeys_law(W, q, mode, sign, mu_s, p_out, u, velocity_tol, scale)
+
+
+@jit
+def _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates):
+    """Contacts that started the step at rest (guess 0), touch at its end (u_N = 0, or u_N equal to
+    the gap-closing velocity) and slide: they must be held if any admissible split can hold them.
+    Returns how many (≤ MAX_CANDIDATES)."""
+    n = 0
+    for i in range(start_guess.shape[0]):
+        if n == MAX_CANDIDATES:
+            break
+        touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
+        if states[i] != STATE_STICK and start_guess[i] == 0.0 and touching \
+                and abs(u[2 * i + 1]) > velocity_tol:
+            candidates[n] = i
+            n += 1
+    return n
+
+
+@jit
+def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign):
+    """Mode of every contact when the candidates in `held_mask` stick and the others slide their
+    way; the rest keep their state (stick, slide, open)."""
+    for i in range(states.shape[0]):
+        sign[i] = 0.0
+        if states[i] == STATE_STICK:
+            mode[i] = MODE_STICK
+        elif states[i] == STATE_SLIP_PLUS or states[i] == STATE_SLIP_MINUS:
+            mode[i] = MODE_SLIDE
+            sign[i] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
+        else:
+            mode[i] = MODE_OPEN
+    for c in range(n_candidates):
+        i = candidates[c]
+        if (held_mask >> c) & 1:
+            mode[i] = MODE_STICK
+            sign[i] = 0.0
+        else:
+            mode[i] = MODE_SLIDE
+            sign[i] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
+
+
+@jit
+def _popcount(mask):
+    count = 0
+    while mask:
+        count += mask & 1
+        mask >>= 1
+    return count
+
+
+@jit
+def _write_solution(W, q, mode, p_new, velocity_tol, p, u, states):
+    """Overwrite p, u and the int64 state codes with the held solution."""
+    p[:] = p_new
+    u[:] = W @ p_new + q
+    for i in range(mode.shape[0]):
+        if mode[i] == MODE_OPEN:
+            states[i] = STATE_OPEN
+        elif mode[i] == MODE_STICK or abs(u[2 * i + 1]) <= velocity_tol:
+            states[i] = STATE_STICK
+        else:
+            states[i] = STATE_SLIP_PLUS if u[2 * i + 1] > 0.0 else STATE_SLIP_MINUS
+
+
+@jit
+def _without_gap_closing(q, closing, mode, q_held):
+    """q with the gap-closing part of the normal rows of closed contacts removed: a held body
+    does not chase gaps of position round-off (they need not be mutually consistent)."""
+    q_held[:] = q
+    for i in range(mode.shape[0]):
+        if mode[i] != MODE_OPEN:
+            q_held[2 * i] -= closing[i]
+
+
+@jit
+def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
+    """Hold what μs can hold: if another admissible solution of the step u = W p + q keeps more of
+    the contacts that started at rest sticking, overwrite p, u, states in place; return True then.
+
+    W (m×m), q (m,), p, u (m,) float64 with m = 2 na ordered (N, T) per contact; mu_s, mu_d,
+    start_guess (na,) float64 — start_guess is the slip guess the step STARTED from (0 at rest,
+    ±1 sliding), not the converged one; velocity_tol: the velocity below which a slip is zero
+    (the sign iteration's); closing (na,) float64: the part g/h of q_N that asks a persistent
+    contact to close an open gap (0 if none) — a held mode may instead leave it open;
+    states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
+    The largest held set wins (ties: the first in contact order); at most MAX_TRIALS tries.
+    """
+    na = mu_s.shape[0]
+    candidates = np.empty(na, dtype=np.int64)
+    n_c = _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates)
+    if n_c == 0:
+        return False
+    w_max = max(1e-300, np.max(np.abs(W)))
+    scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / w_max)
+    if scale <= 0.0:
+        return False
+    mode = np.zeros(na, dtype=np.int64)
+    sign = np.zeros(na)
+    p_new = np.zeros(2 * na)
+    q_held = np.empty(2 * na)
+    chases_gaps = np.max(closing) > 0.0
+    trials = 0
+    for size in range(n_c, 0, -1):
+        for held in range(1, 1 << n_c):
+            if _popcount(held) != size:
+                continue
+            if trials == MAX_TRIALS:
+                return False
+            trials += 1
+            _modes_for(held, candidates, n_c, u, states, mode, sign)
+            admissible = admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+            if not admissible and chases_gaps:
+                _without_gap_closing(q, closing, mode, q_held)
+                admissible = admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+            if admissible:
+                _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
+                return True
+    return False
+
+
+__all__ = ["prefer_sticking", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK",
+           "STATE_SLIP_PLUS", "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE"]

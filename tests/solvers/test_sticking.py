@@ -1,0 +1,153 @@
+"""solvers.sticking: the dense simplex, and prefer_sticking on step problems with several solutions."""
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from nonsmooth_rod.solvers.sticking import (STATE_OPEN, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking,
+                                            simplex_max)
+from nonsmooth_rod.toys import WedgedRod
+
+H = 1e-3
+
+
+def _interpreted(function):
+    return getattr(function, "py_func", function)
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_simplex_agrees_with_highs_on_random_lps(compiled):
+    solve = simplex_max if compiled else _interpreted(simplex_max)
+    rng = np.random.default_rng(7)
+    seen = set()
+    for trial in range(200):
+        m, n = int(rng.integers(1, 8)), int(rng.integers(1, 6))
+        G, h, c = rng.normal(size=(m, n)), rng.normal(size=m), rng.normal(size=n)
+        if trial % 3 == 0:  # boxed: never unbounded
+            G, h = np.vstack([G, np.eye(n)]), np.r_[h, np.full(n, 5.0)]
+        x = np.zeros(n)
+        status = solve(c, G, h, x)
+        ref = linprog(-c, A_ub=G, b_ub=h, bounds=[(0, None)] * n, method="highs")
+        expected = {0: 0, 2: 3, 3: 1}[ref.status]  # HiGHS: 2 infeasible, 3 unbounded
+        if expected == 3 and linprog(np.zeros(n), A_ub=G, b_ub=h, method="highs").status == 0:
+            expected = 1  # HiGHS's presolve calls some unbounded problems infeasible
+        assert status == expected
+        seen.add(status)
+        if status == 0:
+            assert c @ x == pytest.approx(-ref.fun, rel=1e-9, abs=1e-9)
+            assert np.all(G @ x <= h + 1e-9) and np.all(x >= 0)
+    assert seen == {0, 1, 3}  # optimal, unbounded and infeasible problems all occurred
+
+
+def _step_problem(toy, h=H):
+    """W and q of the first Moreau–Jean step of a toy released from rest (every contact active)."""
+    scene = toy.scene()
+    q0, v0 = toy.initial_state()
+    rows = []
+    for c in scene.kinematics(q0, v0):
+        rows += [c.H_N, c.H_T]
+    Hm = np.array(rows)
+    W = Hm @ (scene.inverse_mass_diagonal[:, None] * Hm.T)
+    q = Hm @ (v0 + h * scene.inverse_mass_diagonal * scene.force(0.0, q0, v0))
+    return W, q
+
+
+def _free_fall(q):
+    """The solution every LCP solver returns for the wedged rod: the walls press on nothing."""
+    return np.zeros_like(q), q.copy(), np.full(len(q) // 2, STATE_OPEN, dtype=np.int64)
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_wedged_rod_is_held_when_some_split_can_hold_it(compiled):
+    run = prefer_sticking if compiled else _interpreted(prefer_sticking)
+    toy = WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5)
+    W, q = _step_problem(toy)
+    p, u, states = _free_fall(q)
+    mu_s, mu_d = np.full(2, 0.7), np.full(2, 0.5)
+    assert run(W, q, mu_s, mu_d, np.zeros(2), 1e-9 * np.max(np.abs(q)), np.zeros(2), p, u, states)
+    assert list(states) == [STATE_STICK, STATE_STICK]
+    np.testing.assert_allclose(u, W @ p + q, atol=1e-15)
+    assert np.max(np.abs(u)) < 1e-12 * np.max(np.abs(q))  # at rest at the end of the step
+    pN, pT = p[0::2], p[1::2]
+    assert np.all(pN > 0) and np.all(np.abs(pT) < 0.7 * pN)  # strictly inside both cones
+    # friction carries the weight (wall tangents: left (0, −1), right (0, +1)); the walls squeeze
+    assert pT[1] - pT[0] == pytest.approx(H * toy.mass * toy.g, rel=1e-9)
+    assert pN[0] == pytest.approx(pN[1], rel=1e-9)
+
+
+def test_wedged_rod_that_no_split_can_hold_keeps_falling():
+    toy = WedgedRod(angle=math.radians(30.0), mu_s=0.5, mu_d=0.4)  # tan φ = 0.577 > μs
+    W, q = _step_problem(toy)
+    p, u, states = _free_fall(q)
+    assert not prefer_sticking(W, q, np.full(2, 0.5), np.full(2, 0.4), np.zeros(2), 1e-12, np.zeros(2), p, u, states)
+    assert np.all(p == 0) and np.all(u == q) and np.all(states == STATE_OPEN)
+
+
+def _point_mass_on_floor(slip_speed, mass=2.0, g=9.81, h=H):
+    """One point mass on a floor sliding at `slip_speed`: W = I/m, q = (−g h, v)."""
+    return np.eye(2) / mass, np.array([-g * h, slip_speed])
+
+
+@pytest.mark.parametrize("start_guess, held", [(0.0, True), (1.0, False)])
+def test_only_contacts_that_started_at_rest_are_held(start_guess, held):
+    # v = 0.9 μs g h: sticking (|p_T| = m v ≤ μs p_N) and sliding with μd = μs/2 both obey the law.
+    mass, g, mu_s, mu_d = 2.0, 9.81, 0.4, 0.2
+    v = 0.9 * mu_s * g * H
+    W, q = _point_mass_on_floor(v, mass, g)
+    p = np.array([mass * g * H, -mu_d * mass * g * H])  # the sliding solution
+    u = W @ p + q
+    states = np.array([STATE_SLIP_PLUS], dtype=np.int64)
+    changed = prefer_sticking(W, q, np.array([mu_s]), np.array([mu_d]), np.array([start_guess]), 1e-15,
+                              np.zeros(1), p, u, states)
+    assert changed == held
+    if held:  # a contact at rest starts sliding only when μs cannot hold it
+        assert states[0] == STATE_STICK and abs(u[1]) < 1e-15 and p[1] == pytest.approx(-mass * v)
+    else:  # a sliding contact keeps sliding while the law allows it (the sign iteration's choice)
+        assert states[0] == STATE_SLIP_PLUS and u[1] > 0
+
+
+def test_interpreted_source_gives_the_compiled_split():
+    """NONSMOOTH_ROD_NO_JIT=1 runs every function of sticking.py as plain Python."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = "import json\nfrom test_sticking import wedge_split\nprint(json.dumps(wedge_split().tolist()))"
+    src = Path(__file__).resolve().parents[2] / "src"
+    env = dict(os.environ, NONSMOOTH_ROD_NO_JIT="1",
+               PYTHONPATH=os.pathsep.join([str(src), str(Path(__file__).parent)]))
+    out = subprocess.run([sys.executable, "-c", code], env=env,
+                         capture_output=True, text=True, check=True)
+    interpreted = np.array(json.loads(out.stdout.strip().splitlines()[-1]))
+    compiled = wedge_split()
+    scale = np.max(np.abs(compiled))
+    np.testing.assert_allclose(interpreted, compiled, rtol=0, atol=500 * np.finfo(float).eps * scale)
+
+
+def wedge_split():
+    """The held split of the wedged rod's first step (compiled or not, as _jit decides)."""
+    W, q = _step_problem(WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5))
+    p, u, states = _free_fall(q)
+    assert prefer_sticking(W, q, np.full(2, 0.7), np.full(2, 0.5), np.zeros(2), 1e-9 * np.max(np.abs(q)),
+                           np.zeros(2), p, u, states)
+    return p
+
+
+@pytest.mark.parametrize("told", [True, False])
+def test_a_held_body_leaves_a_round_off_gap_open(told):
+    # The wedged rod has drifted 1e-13 m towards the right wall: the left contact asks to close
+    # that gap (u_N ≥ −g/h), which no squeeze can follow (W is singular); told which part of q
+    # is gap closing, the step holds the rod and leaves the gap open.
+    W, q = _step_problem(WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5))
+    closing = np.array([1e-13 / H, 0.0])
+    q[0] += closing[0]
+    p, u, states = _free_fall(q)
+    held = prefer_sticking(W, q, np.full(2, 0.7), np.full(2, 0.5), np.zeros(2), 1e-9 * np.max(np.abs(q)),
+                           closing if told else np.zeros(2), p, u, states)
+    assert held == told
+    if told:
+        assert list(states) == [STATE_STICK, STATE_STICK]
+        assert u[0] == pytest.approx(closing[0], rel=1e-6) and abs(u[2]) < 1e-15  # H_N v = 0 on both
