@@ -132,11 +132,12 @@ def test_pyramid_short_of_friction_moves_from_the_first_step(mu_disks, mu_floor,
 
 
 def _scene_of_two(first, second):
-    """The bodies and contacts of two one-body toys in one scene (they do not touch)."""
+    """The bodies and contacts of two one-body toys in one scene (they do not touch); the second
+    toy's contacts are renamed "<name>-2" (contact names are unique within a scene)."""
     a, b = first.scene(), second.scene()
     moved = []
     for c in b.contacts:
-        c = type(c)(**{**c.__dict__, "body": c.body + len(a.bodies)})
+        c = type(c)(**{**c.__dict__, "body": c.body + len(a.bodies), "name": f"{c.name}-2"})
         moved.append(c)
     return Scene(a.bodies + b.bodies, a.contacts + moved, gravity=a.gravity)
 
