@@ -24,6 +24,7 @@ class Scene:
     contacts: Sequence = ()
     gravity: float = 9.81
     applied_force: AppliedForce | None = None
+    forces: Sequence = ()  # model.forces: Spring, Damper, ConstantForce, RampedForce, TabulatedForce
 
     def __post_init__(self):
         require_finite("g", self.gravity)
@@ -33,6 +34,13 @@ class Scene:
             raise InputError("a scene needs at least one body")
         self.bodies = list(self.bodies)
         self.contacts = list(self.contacts)
+        from .forces import FORCE_TYPES  # here: forces.py imports the jit decorator
+
+        self.forces = list(self.forces)
+        for i, force in enumerate(self.forces):
+            if not isinstance(force, FORCE_TYPES):
+                raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce or "
+                                 f"TabulatedForce, got {type(force).__name__}")
         self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
         self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
         self.weight = np.zeros(self.n_dof)
@@ -43,9 +51,13 @@ class Scene:
         return 3 * len(self.bodies)
 
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        if self.applied_force is None:
-            return self.weight
-        return self.weight + np.asarray(self.applied_force(t, q, v), dtype=float)
+        """Gravity + the `forces` + the `applied_force` callable at (t, q, v)."""
+        total = self.weight
+        for force in self.forces:
+            total = total + force.generalised_force(t, q, v, self.n_dof)
+        if self.applied_force is not None:
+            total = total + np.asarray(self.applied_force(t, q, v), dtype=float)
+        return total
 
     def kinematics(self, q: np.ndarray, v: np.ndarray):
         return [c.kinematics(q, v, self.n_dof) for c in self.contacts]

@@ -19,12 +19,65 @@ naive "μd if it slid last step" rule gets wrong. See docs/friction.md.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import solvers as _solvers
-from .problem import PlanarFrictionProblem, SolverError
+from .._jit import jit
+from .lemke import CONE, INTERVAL, RAY, RESIDUAL_TOL, SOLVED, _lemke_friction_kernel
+from .problem import NoConvergence, PlanarFrictionProblem, RayTermination, SolverError
+
+# --- the solver call point ---------------------------------------------------------------------
+# API.md's solvers.kernels.solve_interval. Until solvers/kernels.py lands, this local adapter
+# with the same signature and codes serves lemke; switching is replacing this block by
+#     from .kernels import (KERNEL_SOLVED, KERNEL_RAY, KERNEL_NO_CONVERGENCE, KERNEL_TOO_LARGE,
+#                           KERNEL_NONFINITE, SOLVER_LEMKE, SOLVER_PGS, SOLVER_ENUM, solve_interval)
+# and COMPILED_SOLVERS below by all three names.
+KERNEL_SOLVED, KERNEL_RAY, KERNEL_NO_CONVERGENCE, KERNEL_TOO_LARGE, KERNEL_NONFINITE = 0, 1, 2, 3, 4
+SOLVER_LEMKE, SOLVER_PGS, SOLVER_ENUM = 0, 1, 2
+
+
+@jit
+def _lemke_attempt(W, q, lo, hi, formulation, p, u):
+    """One formulation of solvers.lemke.lemke_friction: (status, pivots, residual) and p, u."""
+    na = lo.shape[0]
+    per_contact = 3 if formulation == INTERVAL else 4
+    pp, uu, residual, status, pivots, norms = _lemke_friction_kernel(
+        W, q, lo, hi, 50 + 20 * per_contact * na, formulation)  # lemke._default_max_pivots
+    for r in range(2 * na):
+        p[r] = pp[r]
+        u[r] = uu[r]
+    scale = norms[2] if norms[2] > 0.0 else 1.0
+    if status == SOLVED and not residual <= RESIDUAL_TOL * scale:
+        return KERNEL_NO_CONVERGENCE, pivots, residual
+    if status == SOLVED:
+        return KERNEL_SOLVED, pivots, residual
+    return (KERNEL_RAY if status == RAY else KERNEL_NO_CONVERGENCE), pivots, residual
+
+
+@jit
+def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
+    """API.md's dispatcher, lemke only: the interval LCP, then the cone LCP if that one fails."""
+    if solver_code != SOLVER_LEMKE:
+        return KERNEL_NO_CONVERGENCE, 0, math.inf
+    status, pivots, residual = _lemke_attempt(W, q, lo, hi, INTERVAL, p, u)
+    if status != KERNEL_SOLVED:
+        status, more, residual = _lemke_attempt(W, q, lo, hi, CONE, p, u)
+        pivots += more
+    return status, pivots, residual
+
+
+COMPILED_SOLVERS = {"lemke": SOLVER_LEMKE}
+# --- end of the solver call point --------------------------------------------------------------
+
+# Contact state codes (API.md): open, stick, slip+, slip−.
+STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
+STATE_NAMES = ("open", "stick", "slip+", "slip-")
+# What the sign iteration does after a solve that was not consistent.
+NEXT_RETRY, NEXT_TRY_ZERO, NEXT_STOP = 0, 1, 2
+MAX_SOLVES = 6
 
 
 @dataclass
@@ -39,89 +92,166 @@ class StepContactResult:
     consistent: bool
 
 
-def classify(p: np.ndarray, u: np.ndarray, mu_s: np.ndarray, velocity_tol: float,
-             impulse_tol: float) -> tuple[list[str], np.ndarray, np.ndarray]:
-    """Contact states of a step solution, the slip signs they imply, and their consistency."""
-    n = len(mu_s)
-    states = []
-    signs = np.zeros(n)
-    consistent = np.ones(n, dtype=bool)
-    for i in range(n):
-        pN, pT, uT = p[2 * i], p[2 * i + 1], u[2 * i + 1]
-        if pN <= impulse_tol:
-            states.append("open")
-            continue
-        if uT > velocity_tol:
-            states.append("slip+")
-            signs[i] = 1.0
-        elif uT < -velocity_tol:
-            states.append("slip-")
-            signs[i] = -1.0
+@jit
+def classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
+    """States of a step solution under slip guess `guess`; True when the guess is consistent.
+
+    A contact is consistent when it opened, slid the way the guess said, or stuck inside the
+    static cone (under any guess). An inconsistent contact's new guess: a wrong non-zero guess
+    falls back to 0 (the ordinary μs problem, where sticking is tried first); only a contact that
+    slides even then takes the sign it slid with (or, sticking outside the cone, the sign that
+    opposes its friction). Jumping from one slip sign to the other could skip an admissible stick.
+    """
+    # A slip velocity within the solver's own accuracy is zero (iterative solvers leave
+    # residuals of 1e-12..1e-9; Lemke's is round-off).
+    v_tol = max(velocity_tol, 10.0 * residual)
+    scale_p = 1e-300
+    for r in range(p.shape[0]):
+        scale_p = max(scale_p, abs(p[r]))
+    p_tol = 1e-12 * scale_p
+    consistent = True
+    for j in range(guess.shape[0]):
+        p_n, p_t, u_t = p[2 * j], p[2 * j + 1], u[2 * j + 1]
+        implied = guess[j]
+        outside_cone = False
+        if p_n <= p_tol:
+            states[j] = STATE_OPEN
+        elif u_t > v_tol:
+            states[j] = STATE_SLIP_PLUS
+            implied = 1.0
+        elif u_t < -v_tol:
+            states[j] = STATE_SLIP_MINUS
+            implied = -1.0
         else:
-            states.append("stick")
-            # Sticking is admissible only inside the static cone; otherwise the contact slips
-            # against the friction it could not supply.
-            if abs(pT) > mu_s[i] * pN * (1 + 1e-9) + impulse_tol:
-                consistent[i] = False
-                signs[i] = -np.sign(pT)
-    return states, signs, consistent
+            states[j] = STATE_STICK
+            if abs(p_t) > mu_s[j] * p_n * (1 + 1e-9) + p_tol:  # outside the static cone
+                outside_cone = True
+                implied = -1.0 if p_t > 0.0 else (1.0 if p_t < 0.0 else 0.0)
+        new_guess[j] = guess[j]
+        if outside_cone or implied != guess[j]:
+            consistent = False
+            new_guess[j] = 0.0 if guess[j] != 0.0 else implied
+    return consistent
+
+
+@jit
+def _seen(tried, n_tried, guess):
+    for k in range(n_tried):
+        same = True
+        for j in range(guess.shape[0]):
+            if tried[k, j] != guess[j]:
+                same = False
+        if same:
+            return True
+    return False
+
+
+@jit
+def next_action(new_guess, tried, n_tried):
+    """After an inconsistent solve: retry with new_guess, or — cycling between guesses (possible
+    only with several interacting contacts) or out of solves — solve the ordinary μs problem
+    once (exact for sticking; the caller counts the step as inconsistent), or stop."""
+    if n_tried < tried.shape[0] - 1 and not _seen(tried, n_tried, new_guess):
+        return NEXT_RETRY
+    for j in range(new_guess.shape[0]):
+        new_guess[j] = 0.0
+    return NEXT_STOP if _seen(tried, n_tried, new_guess) else NEXT_TRY_ZERO
+
+
+@jit
+def _interval_of(mu_s, mu_d, guess, lo, hi):
+    """The friction interval [c − μs, c + μs], c = (μs − μd) s, of slip guess s."""
+    for j in range(guess.shape[0]):
+        shift = (mu_s[j] - mu_d[j]) * guess[j]
+        lo[j] = shift - mu_s[j]
+        hi[j] = shift + mu_s[j]
+
+
+@jit
+def two_coefficient_kernel(solver_code, W, q, mu_s, mu_d, guess, rtol, max_iter, p, u, states):
+    """The exact two-coefficient law on u = W p + q, from slip guess `guess` (updated in place to
+    the converged guess). Returns (kernel status, solves, solver iterations, consistent)."""
+    na = guess.shape[0]
+    lo, hi, new_guess = np.empty(na), np.empty(na), np.empty(na)
+    tried = np.empty((MAX_SOLVES + 1, na))
+    scale_v = 1e-12
+    for r in range(2 * na):
+        scale_v = max(scale_v, abs(q[r]))
+    velocity_tol = 1e-9 * scale_v
+    n_tried, iterations, consistent = 0, 0, False
+    while True:
+        tried[n_tried] = guess
+        n_tried += 1
+        _interval_of(mu_s, mu_d, guess, lo, hi)
+        status, its, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+        iterations += its
+        if status != KERNEL_SOLVED:
+            return status, n_tried, iterations, False
+        if classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
+            consistent = True
+            break
+        action = next_action(new_guess, tried, n_tried)
+        guess[:] = new_guess
+        if action == NEXT_RETRY:
+            continue
+        if action == NEXT_TRY_ZERO:
+            _interval_of(mu_s, mu_d, guess, lo, hi)
+            status, its, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+            iterations += its
+            n_tried += 1
+            if status != KERNEL_SOLVED:
+                return status, n_tried, iterations, False
+            classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess)
+        break
+    return KERNEL_SOLVED, n_tried, iterations, consistent
 
 
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
                           slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
-                          max_solves: int = 6) -> StepContactResult:
-    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`."""
-    mu_s = np.asarray(mu_s, dtype=float)
-    mu_d = np.asarray(mu_d, dtype=float)
+                          max_solves: int = MAX_SOLVES) -> StepContactResult:
+    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`, with
+    any solver of solvers.solve (the same rule as two_coefficient_kernel: classify_solution and
+    next_action). Raises the solver's SolverError when a solve fails."""
+    W = np.ascontiguousarray(W, dtype=float)
+    q = np.ascontiguousarray(q, dtype=float)
+    mu_s = np.ascontiguousarray(mu_s, dtype=float)
+    mu_d = np.ascontiguousarray(mu_d, dtype=float)
     guess = np.array(slip_guess, dtype=float)
-    scale_v = max(1e-12, float(np.max(np.abs(q))))
-    velocity_tol = 1e-9 * scale_v
-    tried = set()
-    iterations = 0
-    best = None
-    for solves in range(1, max_solves + 1):
-        key = tuple(guess)
-        tried.add(key)
-        shift = (mu_s - mu_d) * guess
-        problem = PlanarFrictionProblem(W, q, shift - mu_s, shift + mu_s)
-        sol = _solvers.solve(problem, solver, **(solver_options or {}))
+    na = guess.shape[0]
+    classify, action_of = _python(classify_solution), _python(next_action)
+    lo, hi, new_guess, states = np.empty(na), np.empty(na), np.empty(na), np.zeros(na, dtype=np.int64)
+    tried = np.empty((max_solves + 1, na))
+    velocity_tol = 1e-9 * max(1e-12, float(np.max(np.abs(q), initial=0.0)))
+    n_tried, iterations, consistent = 0, 0, False
+    while True:
+        tried[n_tried] = guess
+        n_tried += 1
+        _python(_interval_of)(mu_s, mu_d, guess, lo, hi)
+        sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
         iterations += sol.iterations
-        p, u = sol.p, sol.u
-        scale_p = max(1e-300, float(np.max(np.abs(p))))
-        # A slip velocity within the solver's own accuracy is zero (iterative and QP
-        # solvers leave residuals of 1e-12..1e-9; Lemke's is round-off).
-        step_velocity_tol = max(velocity_tol, 10.0 * sol.residual)
-        states, implied, ok = classify(p, u, mu_s, step_velocity_tol, 1e-12 * scale_p)
-        # A guess is consistent for a contact when the step slid the way the guess said, or
-        # stuck inside the static cone (any guess), or opened.
-        for i, st in enumerate(states):
-            if st in ("slip+", "slip-") and implied[i] != guess[i]:
-                ok[i] = False
-        best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
-        if ok.all():
-            return best
-        # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
-        # tried first); only a contact that slides even then takes the sign it slid with.
-        # Jumping straight from one slip sign to the other could skip an admissible stick.
-        new_guess = guess.copy()
-        for i in range(len(guess)):
-            if not ok[i]:
-                new_guess[i] = 0.0 if guess[i] != 0.0 else implied[i]
-        if tuple(new_guess) in tried:
+        if classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess):
+            consistent = True
             break
-        guess = new_guess
-    # Cycling between guesses (possible only with several interacting contacts): keep the
-    # ordinary μs solution, which is exact for sticking, and let the caller count it.
-    if best is not None and not best.consistent:
-        zero = np.zeros_like(guess)
-        if tuple(zero) not in tried:
-            problem = PlanarFrictionProblem(W, q, -mu_s, mu_s)
-            sol = _solvers.solve(problem, solver, **(solver_options or {}))
-            states, implied, _ = classify(sol.p, sol.u, mu_s, max(velocity_tol, 10.0 * sol.residual),
-                                          1e-12 * max(1e-300, np.max(np.abs(sol.p))))
-            best = StepContactResult(sol.p, sol.u, states, zero, best.solves + 1,
-                                     iterations + sol.iterations, sol.residual, False)
-    return best
+        action = action_of(new_guess, tried, n_tried)
+        guess[:] = new_guess
+        if action == NEXT_RETRY:
+            continue
+        if action == NEXT_TRY_ZERO:
+            _python(_interval_of)(mu_s, mu_d, guess, lo, hi)
+            sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
+            iterations += sol.iterations
+            n_tried += 1
+            classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess)
+        break
+    return StepContactResult(np.asarray(sol.p, dtype=float), np.asarray(sol.u, dtype=float),
+                             [STATE_NAMES[s] for s in states], guess.copy(), n_tried, iterations,
+                             float(sol.residual), consistent)
 
 
-__all__ = ["solve_two_coefficient", "StepContactResult", "classify", "SolverError"]
+def _python(kernel):
+    """The plain-Python function behind a kernel (so Python callers never trigger a compile)."""
+    return getattr(kernel, "py_func", kernel)
+
+
+__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "StepContactResult", "classify_solution",
+           "next_action", "solve_interval", "SolverError", "STATE_NAMES"]

@@ -1,0 +1,300 @@
+"""The one Moreau–Jean loop, on arrays: compiled with numba, or plain Python from the same source.
+
+A step of size h from (q_k, v_k), for a packed scene (model.packing):
+
+    begin_step   v_free = v_k + h M⁻¹ f; contact kinematics; the contacts that enter the step
+    assemble     W = H M⁻¹ Hᵀ over the active contacts, q_step, the slip guesses, μs, μd
+    (solve)      the exact two-coefficient law (solvers.two_coefficient.two_coefficient_kernel,
+                 or the Python solve_two_coefficient for the QP solvers)
+    finish_step  v_{k+1} = v_free + M⁻¹ Hᵀ p, q_{k+1} = q_k + h((1−θ) v_k + θ v_{k+1}), records,
+                 impacts, contact memory
+
+`run_steps` runs them for a range of steps with the packed forces (the whole run is one
+compiled call); `compiled_step` runs one step with a force given by the caller (the step-wise
+loop that calls back a Python `applied_force`). Arrays are grouped in three tuples so every
+kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
+(records). Their layouts are built by `allocate` in moreau_jean.py.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import jit
+from ..model.forces import accumulate_forces
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_BODY_B,
+                             contact_kinematics, local_dot)
+from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
+                                       two_coefficient_kernel)
+
+# Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
+# of a few ulps either side of zero, and must not be left out of the step for that.
+ACTIVATION_ROUNDOFF = 1e-12
+# A contact closes "with approaching velocity" when u_N before the step is below this.
+IMPACT_VELOCITY_TOL = 1e-9
+# Run status codes.
+RUN_OK, RUN_SOLVER_FAILED, RUN_NONFINITE, RUN_STOPPED, RUN_BAD_GEOMETRY = 0, 1, 2, 3, 4
+# Slots of the int64 `counters` record.
+(K_DONE, K_STATUS, K_FAIL_STEP, K_N_IMPACTS, K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_SOLVER_STATUS,
+ K_FAIL_CONTACT) = range(9)
+N_COUNTERS = 9
+# Float parameters: h, θ, γ (activation), t0, solver rtol. Int parameters: solver code, max
+# iterations, stop contact (−1: none).
+P_H, P_THETA, P_GAMMA, P_T0, P_RTOL = range(5)
+I_SOLVER, I_MAX_ITER, I_STOP = range(3)
+
+
+@jit
+def begin_step(params, qk, vk, f, model, work):
+    """Free velocity, contact kinematics and the active set; returns na (−1 − i: contact i has
+    coincident disk centres)."""
+    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
+    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    h, gamma = params[P_H], params[P_GAMMA]
+    for d in range(qk.shape[0]):
+        a_free[d] = minv[d] * f[d]
+        v_free[d] = vk[d] + h * a_free[d]
+    na = 0
+    for i in range(table.shape[0]):
+        gap, drift = contact_kinematics(table, index, i, qk, vk, hn[i], ht[i])
+        if math.isnan(gap):
+            return -1 - i
+        gaps[i], drifts[i] = gap, drift
+        predicted = gap + gamma * h * local_dot(hn[i], index, i, vk)
+        margin = ACTIVATION_ROUNDOFF
+        if was_closed[i]:
+            # A contact that acted in the previous step stays while its predicted gap is within
+            # the gap change one step of its own acceleration can cause (h² |g̈|): the velocity-
+            # level law lets a resting contact's gap wander by that much.
+            margin = h * h * (abs(drift) + abs(local_dot(hn[i], index, i, a_free)))
+        if predicted <= margin:
+            active[na] = i
+            na += 1
+    return na
+
+
+@jit
+def _block_product(row_i, index, i, row_j, j, minv):
+    """row_i M⁻¹ row_jᵀ for two contacts' 6-entry rows: the bodies they share."""
+    s = 0.0
+    for side_i in range(2):
+        body = index[i, CI_BODY_A + side_i]
+        if body < 0:
+            continue
+        for side_j in range(2):
+            if index[j, CI_BODY_A + side_j] == body:
+                for d in range(3):
+                    s += row_i[3 * side_i + d] * minv[3 * body + d] * row_j[3 * side_j + d]
+    return s
+
+
+@jit
+def assemble(params, na, vk, model, work, W, q_step, guess, mu_s, mu_d):
+    """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
+    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
+    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    h = params[P_H]
+    for a in range(na):
+        i = active[a]
+        for b in range(na):
+            j = active[b]
+            W[2 * a, 2 * b] = _block_product(hn[i], index, i, hn[j], j, minv)
+            W[2 * a, 2 * b + 1] = _block_product(hn[i], index, i, ht[j], j, minv)
+            W[2 * a + 1, 2 * b] = _block_product(ht[i], index, i, hn[j], j, minv)
+            W[2 * a + 1, 2 * b + 1] = _block_product(ht[i], index, i, ht[j], j, minv)
+        surface = table[i, C_SURFACE_VELOCITY]
+        q_step[2 * a + 1] = local_dot(ht[i], index, i, v_free) - surface
+        mu_s[a], mu_d[a] = table[i, C_MU_S], table[i, C_MU_D]
+        if was_closed[i]:
+            # A persistent contact may close an open gap, not only keep u_N ≥ 0: the Jacobian
+            # turns with the body within the step, so a purely velocity-level law lets the gap
+            # creep open by O(h) per unit time. u_N ≥ −g/h for g > 0 removes the creep; a
+            # penetration (g < 0) is not pushed out, which would inject energy after impacts.
+            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + max(gaps[i], 0.0) / h
+            guess[a] = slip_sign[i]
+        else:
+            u_n = local_dot(hn[i], index, i, vk)
+            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + table[i, C_RESTITUTION] * min(u_n, 0.0)
+            u_t = local_dot(ht[i], index, i, vk) - surface  # a closing contact slides the way it arrives
+            guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
+
+
+@jit
+def crossing_offset(g, u, a, h):
+    """Root τ of g + u τ + ½ a τ² nearest 0 within [−h, 2h] (0 if none): where in the step the
+    gap crossed zero. The contact may enter the problem a little before (predicted gap) or after
+    (closing late in the previous step) the crossing."""
+    best = math.nan
+    r1 = math.nan
+    r2 = math.nan
+    if abs(a) > 1e-14:
+        disc = u * u - 2.0 * a * g
+        if disc >= 0.0:
+            sq = math.sqrt(disc)
+            r1 = (-u - sq) / a
+            r2 = (-u + sq) / a
+    elif u != 0.0:
+        r1 = -g / u
+    for r in (r1, r2):
+        if not math.isnan(r) and -h <= r <= 2 * h:
+            if math.isnan(best) or abs(r) < abs(best):
+                best = r
+    return 0.0 if math.isnan(best) else best
+
+
+@jit
+def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
+    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    index = model[3]
+    impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
+    h = params[P_H]
+    n = counters[K_N_IMPACTS]
+    if n >= impact_t.shape[0]:  # the record is full: the impact still acts, unrecorded
+        return i == iparams[I_STOP]
+    impact_t[n] = t + crossing_offset(gaps[i], u_before, local_dot(hn[i], index, i, a_free) + drifts[i], h)
+    impact_step[n] = k
+    impact_contact[n] = i
+    counters[K_N_IMPACTS] = n + 1
+    return i == iparams[I_STOP]
+
+
+@jit
+def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
+    """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
+    status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
+    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
+    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    q, v, p_normal, p_tangent, slip, state_rec = out[0], out[1], out[2], out[3], out[4], out[5]
+    h, theta = params[P_H], params[P_THETA]
+    t = params[P_T0] + k * h
+    v_next = v[k + 1]
+    v_next[:] = v_free
+    for a in range(na):
+        i = active[a]
+        for side in range(2):
+            body = index[i, CI_BODY_A + side]
+            if body >= 0:
+                for d in range(3):
+                    v_next[3 * body + d] += minv[3 * body + d] * (hn[i, 3 * side + d] * p[2 * a]
+                                                                  + ht[i, 3 * side + d] * p[2 * a + 1])
+    finite = True
+    for d in range(qk.shape[0]):
+        q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
+        finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
+    status = RUN_OK
+    for i in range(table.shape[0]):
+        p_normal[k, i] = 0.0
+        p_tangent[k, i] = 0.0
+        state_rec[k, i] = 0
+        slip[k, i] = local_dot(ht[i], index, i, v_next) - table[i, C_SURFACE_VELOCITY]
+    for a in range(na):
+        i = active[a]
+        p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]
+        slip_sign[i] = 1.0 if states[a] == STATE_SLIP_PLUS else (-1.0 if states[a] == STATE_SLIP_MINUS else 0.0)
+    for i in range(table.shape[0]):
+        closed = p_normal[k, i] > 0.0
+        if closed and not was_closed[i] and not touching[i]:
+            # An impact: a contact that was apart closes with approaching velocity. A persistent
+            # contact whose impulse lapsed for a step (its gap drifted) is not one.
+            u_before = local_dot(hn[i], index, i, vk)
+            if u_before < -IMPACT_VELOCITY_TOL and _record_impact(k, t, i, u_before, work, model, out, params,
+                                                                  iparams):
+                status = RUN_STOPPED
+        was_closed[i] = 1 if closed else 0
+        touching[i] = _still_touching(i, closed, touching[i], params, work, index)
+    if not finite:
+        return RUN_NONFINITE
+    return status
+
+
+@jit
+def _still_touching(i, closed, touching, params, work, index):
+    """Does contact i stay in touch? It starts touching when it carries impulse, and stops once
+    its gap opens beyond what one step's drift of a persistent contact explains."""
+    gaps, drifts, hn, ht, active, was_closed, touching_all, slip_sign, v_free, a_free = work
+    if closed:
+        return 1
+    h = params[P_H]
+    reach = 4.0 * h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
+    return 1 if touching and gaps[i] <= reach else 0
+
+
+@jit
+def solve_step(params, iparams, na, vk, model, work, out):
+    """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
+    m = 2 * na
+    W = np.zeros((m, m))
+    q_step = np.empty(m)
+    guess, mu_s, mu_d = np.empty(na), np.empty(na), np.empty(na)
+    assemble(params, na, vk, model, work, W, q_step, guess, mu_s, mu_d)
+    p, u = np.zeros(m), np.zeros(m)
+    states = np.zeros(na, dtype=np.int64)
+    status, solves, iterations, consistent = two_coefficient_kernel(
+        iparams[I_SOLVER], W, q_step, mu_s, mu_d, guess, params[P_RTOL], iparams[I_MAX_ITER], p, u, states)
+    # --- prefer_sticking call point (API.md; solvers/sticking.py, branch `step`) -------------
+    # Once the sign iteration is consistent, a colleague's prefer_sticking(W, q_step, mu_s, mu_d,
+    # guess, p, u, states) may overwrite p, u, states with a solution that keeps more contacts
+    # sticking. Wire it here:
+    #     if status == KERNEL_SOLVED and consistent:
+    #         prefer_sticking(W, q_step, mu_s, mu_d, guess, p, u, states)
+    counters = out[9]
+    counters[K_SOLVES] += solves
+    counters[K_ITERATIONS] += iterations
+    if status == KERNEL_SOLVED and not consistent:
+        counters[K_INCONSISTENT] += 1
+    return status, p, u, states
+
+
+@jit
+def compiled_step(k, f, params, iparams, model, work, out):
+    """One whole step with generalised force f; returns a run status."""
+    q, v, counters = out[0], out[1], out[9]
+    qk, vk = q[k], v[k]
+    na = begin_step(params, qk, vk, f, model, work)
+    if na < 0:
+        counters[K_FAIL_CONTACT] = -1 - na
+        return RUN_BAD_GEOMETRY
+    p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
+    if na > 0:
+        status, p, u, states = solve_step(params, iparams, na, vk, model, work, out)
+        if status != KERNEL_SOLVED:
+            counters[K_SOLVER_STATUS] = status
+            return RUN_SOLVER_FAILED
+    return finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out)
+
+
+@jit
+def step_force(k, params, model, out, f):
+    """f = weight + the packed forces at t_k + θh and (q_k, v_k)."""
+    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
+    q, v = out[0], out[1]
+    f[:] = weight
+    t = params[P_T0] + (k + params[P_THETA]) * params[P_H]
+    accumulate_forces(t, q[k], v[k], ftable, findex, ftimes, fvalues, f)
+
+
+@jit
+def end_of_step(k, status, counters):
+    """Book step k's outcome in the counters (steps done; how and where the run ended)."""
+    if status == RUN_OK or status == RUN_STOPPED:
+        counters[K_DONE] = k + 1
+    if status != RUN_OK:
+        counters[K_STATUS] = status
+        counters[K_FAIL_STEP] = k
+    return status
+
+
+@jit
+def run_steps(k_start, k_end, params, iparams, model, work, out):
+    """Steps k_start … k_end − 1 with the packed forces: the whole run in one call."""
+    f = np.empty(model[0].shape[0])
+    for k in range(k_start, k_end):
+        step_force(k, params, model, out, f)
+        if end_of_step(k, compiled_step(k, f, params, iparams, model, work, out), out[9]) != RUN_OK:
+            return out[9][K_STATUS]
+    return RUN_OK
+
+
+__all__ = ["begin_step", "assemble", "solve_step", "finish_step", "compiled_step", "step_force", "run_steps",
+           "crossing_offset", "ACTIVATION_ROUNDOFF"]
