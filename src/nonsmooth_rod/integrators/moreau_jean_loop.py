@@ -25,12 +25,14 @@ from .._jit import jit
 from ..model.forces import accumulate_forces
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_BODY_B,
                              contact_kinematics, local_dot)
-from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
+from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
                                        two_coefficient_kernel)
 
 # Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
 # of a few ulps either side of zero, and must not be left out of the step for that.
 ACTIVATION_ROUNDOFF = 1e-12
+# Multiple of h² |g̈| within which a closed contact's gap counts as closed (persistence_margin).
+PERSISTENCE_FACTOR = 4.0
 # A contact closes "with approaching velocity" when u_N before the step is below this.
 IMPACT_VELOCITY_TOL = 1e-9
 # Run status codes.
@@ -46,11 +48,24 @@ I_SOLVER, I_MAX_ITER, I_STOP = range(3)
 
 
 @jit
+def persistence_margin(h, drift, free_acceleration):
+    """How far a closed contact's gap may open and the contact still count as closed.
+
+    The velocity-level law with start-of-step Jacobians lets a loaded contact's gap wander by the
+    change one step of its acceleration causes, h² |g̈| — and the Jacobian's turn within the step
+    (h² |Ḣ_N v|) moves it by as much again each step (a ladder's top on its wall: +1.5 mm/s of
+    normal velocity while loaded, at h = 1 ms). Keeping such a contact in the step costs nothing
+    when it truly separates: the gap-keeping law u_N ≥ −g/h then leaves it without impulse.
+    """
+    return PERSISTENCE_FACTOR * h * h * (abs(drift) + abs(free_acceleration)) + ACTIVATION_ROUNDOFF
+
+
+@jit
 def begin_step(params, qk, vk, f, model, work):
     """Free velocity, contact kinematics and the active set; returns na (−1 − i: contact i has
     coincident disk centres)."""
     minv, weight, table, index, ftable, findex, ftimes, fvalues = model
-    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
     h, gamma = params[P_H], params[P_GAMMA]
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
@@ -64,10 +79,7 @@ def begin_step(params, qk, vk, f, model, work):
         predicted = gap + gamma * h * local_dot(hn[i], index, i, vk)
         margin = ACTIVATION_ROUNDOFF
         if was_closed[i]:
-            # A contact that acted in the previous step stays while its predicted gap is within
-            # the gap change one step of its own acceleration can cause (h² |g̈|): the velocity-
-            # level law lets a resting contact's gap wander by that much.
-            margin = h * h * (abs(drift) + abs(local_dot(hn[i], index, i, a_free)))
+            margin = persistence_margin(h, drift, local_dot(hn[i], index, i, a_free))
         if predicted <= margin:
             active[na] = i
             na += 1
@@ -93,7 +105,7 @@ def _block_product(row_i, index, i, row_j, j, minv):
 def assemble(params, na, vk, model, work, W, q_step, guess, mu_s, mu_d):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
     minv, weight, table, index, ftable, findex, ftimes, fvalues = model
-    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
     h = params[P_H]
     for a in range(na):
         i = active[a]
@@ -145,7 +157,7 @@ def crossing_offset(g, u, a, h):
 
 @jit
 def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
-    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
     index = model[3]
     impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
     h = params[P_H]
@@ -164,7 +176,7 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
     status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
     minv, weight, table, index, ftable, findex, ftimes, fvalues = model
-    gaps, drifts, hn, ht, active, was_closed, touching, slip_sign, v_free, a_free = work
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
     q, v, p_normal, p_tangent, slip, state_rec = out[0], out[1], out[2], out[3], out[4], out[5]
     h, theta = params[P_H], params[P_THETA]
     t = params[P_T0] + k * h
@@ -188,36 +200,42 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
         p_tangent[k, i] = 0.0
         state_rec[k, i] = 0
         slip[k, i] = local_dot(ht[i], index, i, v_next) - table[i, C_SURFACE_VELOCITY]
+    for i in range(table.shape[0]):
+        grazing[i] = 0
     for a in range(na):
         i = active[a]
         p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]
-        slip_sign[i] = 1.0 if states[a] == STATE_SLIP_PLUS else (-1.0 if states[a] == STATE_SLIP_MINUS else 0.0)
+        if states[a] == STATE_OPEN and was_closed[i] and _rides_the_gap(i, params, work, index, v_next):
+            grazing[i] = 1  # no force this step (reported open), yet not apart: no impact on return
+        slip_sign[i] = 1.0 if state_rec[k, i] == STATE_SLIP_PLUS else (-1.0 if state_rec[k, i] == STATE_SLIP_MINUS
+                                                                        else 0.0)
     for i in range(table.shape[0]):
         closed = p_normal[k, i] > 0.0
-        if closed and not was_closed[i] and not touching[i]:
+        if closed and not was_closed[i]:
             # An impact: a contact that was apart closes with approaching velocity. A persistent
-            # contact whose impulse lapsed for a step (its gap drifted) is not one.
+            # contact that rode its gap without impulse for a step stays closed (grazing), so it
+            # is not one.
             u_before = local_dot(hn[i], index, i, vk)
             if u_before < -IMPACT_VELOCITY_TOL and _record_impact(k, t, i, u_before, work, model, out, params,
                                                                   iparams):
                 status = RUN_STOPPED
-        was_closed[i] = 1 if closed else 0
-        touching[i] = _still_touching(i, closed, touching[i], params, work, index)
+        was_closed[i] = 1 if closed or grazing[i] else 0
     if not finite:
         return RUN_NONFINITE
     return status
 
 
 @jit
-def _still_touching(i, closed, touching, params, work, index):
-    """Does contact i stay in touch? It starts touching when it carries impulse, and stops once
-    its gap opens beyond what one step's drift of a persistent contact explains."""
-    gaps, drifts, hn, ht, active, was_closed, touching_all, slip_sign, v_free, a_free = work
-    if closed:
-        return 1
+def _rides_the_gap(i, params, work, index, v_next):
+    """A persistent contact that got no impulse but ends the step within h² |g̈| of
+    its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
+    step is no impact — near a lift-off the normal force fades and such steps alternate with
+    loaded ones."""
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
     h = params[P_H]
-    reach = 4.0 * h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
-    return 1 if touching and gaps[i] <= reach else 0
+    # within one step's worth of its acceleration, h² |g̈|: a hop of a ball at rest is longer
+    margin = h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
+    return gaps[i] + h * local_dot(hn[i], index, i, v_next) <= margin
 
 
 @jit
