@@ -6,11 +6,16 @@
     <backend>             Tresca fixed point of QPs through qpsolvers (e.g. osqp, clarabel)
     <backend>-relaxed     convex relaxation, one QP (has the sliding-separation artefact)
 
+The exact solvers run compiled kernels (`solvers.kernels.solve_interval`, numba when installed,
+the same source interpreted otherwise). `solvers.lcp.lemke(M, q)` solves any LCP
+0 ≤ z ⊥ M z + q ≥ 0 (public API). Non-finite data are refused where the problem is made.
+
 The QP solvers exist for every backend qpsolvers reports installed; qpsolvers itself is an
 optional extra, imported only when a QP solver is listed or used.
 """
 from __future__ import annotations
 
+from ..validation import InputError
 from .problem import (
     ContactSolution,
     InfeasibleProblem,
@@ -43,6 +48,15 @@ def _exact_solver(name: str):
 _EXACT_LOADED: dict = {}
 
 
+def __getattr__(name: str):
+    """`solvers.lcp` (the generic LCP API) and `solvers.kernels` load on first use (numba)."""
+    if name in ("lcp", "kernels"):
+        import importlib
+
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 def available_solvers() -> list[str]:
     """Solver names ``solve`` accepts: lemke, pgs, enum, then per installed QP backend its
     name and name + "-relaxed"."""
@@ -61,8 +75,13 @@ def solve(problem: PlanarFrictionProblem, solver: str = "lemke", **options) -> C
     max_pivots; QP: tol, max_iter, check_tol and backend settings). The returned
     ContactSolution carries iterations, the common residual and info["states"] (per contact
     "open" | "stick" | "slip+" | "slip-"). Raises SolverError subclasses on failure and
-    ValueError for an unknown solver name.
+    InputError (a ValueError) for an unknown solver name, listing the choices. Non-finite
+    data never get here: PlanarFrictionProblem refuses them (InputError naming W, q, lo or hi).
     """
+    if not isinstance(problem, PlanarFrictionProblem):
+        raise InputError(f"solve: problem must be a PlanarFrictionProblem, got {type(problem).__name__}")
+    if not isinstance(solver, str):
+        raise InputError(f"unknown solver {solver!r}; choose from: {', '.join(available_solvers())}")
     run = _exact_solver(solver)
     if run is not None:
         return run(problem, **options)
@@ -73,7 +92,7 @@ def solve(problem: PlanarFrictionProblem, solver: str = "lemke", **options) -> C
         return tresca_fixed_point(problem, backend=solver, **options)
     if solver.endswith(RELAXED_SUFFIX) and solver[: -len(RELAXED_SUFFIX)] in backends:
         return relaxed_qp(problem, backend=solver[: -len(RELAXED_SUFFIX)], **options)
-    raise ValueError(f"unknown solver {solver!r}; choose from: {', '.join(available_solvers())}")
+    raise InputError(f"unknown solver {solver!r}; choose from: {', '.join(available_solvers())}")
 
 
 __all__ = [

@@ -1,30 +1,25 @@
 """Small pieces shared by the solver modules (not public API)."""
 from __future__ import annotations
 
+import types
+
 import numpy as np
 
-from .problem import ContactSolution, PlanarFrictionProblem, contact_states
+from ..validation import InputError
+from .problem import ContactSolution, PlanarFrictionProblem, _require_finite, contact_states
 
 
 def velocities_and_residual(W, q, lo, hi, p):
-    """u = W p + q and the `complementarity_residual`, in plain Python floats.
+    """u = W p + q (a list) and the `complementarity_residual`, through the kernels'
+    `kernel_base.step_residual` (the tests hold it to problem.py's numpy formula)."""
+    from .kernel_base import step_residual
 
-    Same formula as `problem.complementarity_residual` (the tests check they agree); for the
-    2–4 unknowns of a step, float loops over lists beat a dozen small numpy calls.
-    ``W`` is a list of rows, ``q``, ``lo``, ``hi``, ``p`` are lists.
-    """
-    n = len(q)
-    u = [q[i] + sum(w_ij * p_j for w_ij, p_j in zip(W[i], p)) for i in range(n)]
-    residual = 0.0
-    for i in range(n // 2):
-        p_n, p_t, u_n, u_t = p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1]
-        r_n = abs(min(p_n, u_n))
-        p_n_pos = max(p_n, 0.0)
-        trial = p_t - u_t
-        low, high = lo[i] * p_n_pos, hi[i] * p_n_pos
-        projected = low if trial < low else (high if trial > high else trial)
-        residual = max(residual, r_n, abs(p_t - projected))
-    return u, residual
+    q = np.array(q, dtype=float)
+    p = np.array(p, dtype=float)
+    u = np.zeros_like(q)
+    residual = step_residual(np.array(W, dtype=float), q, np.array(lo, dtype=float),
+                             np.array(hi, dtype=float), p, u)
+    return u.tolist(), float(residual)
 
 
 # Residuals below this count as zero whatever the scale: with subnormal data (|q| ~ 1e-313)
@@ -55,3 +50,34 @@ def make_solution(
     p = np.asarray(p, dtype=float)
     u = np.asarray(u, dtype=float)
     return ContactSolution(p=p, u=u, solver=solver, iterations=iterations, residual=residual, info=info)
+
+
+def require_finite_array(name: str, values: np.ndarray, who: str = "") -> None:
+    """InputError naming the argument (and ``who`` refused it) at its first NaN/inf entry."""
+    try:
+        _require_finite(name, values)
+    except InputError as error:
+        raise InputError(f"{who}: {error}" if who else str(error)) from None
+
+
+_INTERPRETED: dict = {}
+
+
+def interpreted(function):
+    """The plain-Python twin of a `_jit.jit` kernel: its source run by the interpreter, and so
+    every compiled kernel it calls (their globals rebound to interpreted twins, recursively).
+    Without numba the kernels are plain functions already and come back unchanged. Lets
+    ``jit=False`` and the compiled-vs-interpreted tests run the one source both ways."""
+    python = getattr(function, "py_func", None)
+    if python is None:
+        return function
+    twin = _INTERPRETED.get(id(function))
+    if twin is None:
+        namespace = dict(python.__globals__)
+        twin = types.FunctionType(python.__code__, namespace, python.__name__, python.__defaults__,
+                                  python.__closure__)
+        _INTERPRETED[id(function)] = twin
+        for name, value in list(namespace.items()):
+            if getattr(value, "py_func", None) is not None and callable(value):
+                namespace[name] = interpreted(value)
+    return twin

@@ -8,8 +8,9 @@ contact's two conditions into two linear equations on p:
     slip+   u_N = 0,  p_T = lo·p_N                  (needs p_N ≥ 0, u_T ≥ 0)
     slip−   u_N = 0,  p_T = hi·p_N                  (needs p_N ≥ 0, u_T ≤ 0)
 
-All 4^n_c combinations are solved at once (a stack of 2n_c × 2n_c systems) with the
-pseudo-inverse, i.e. the least-norm solution when a system is singular (statically
+All 4^n_c combinations are solved in one compiled kernel (`enum_interval`, the same source
+interpreted without numba; up to MAX_CONTACTS contacts, KERNEL_TOO_LARGE beyond), each
+2n_c × 2n_c system with the pseudo-inverse (SVD), i.e. the least-norm solution when a system is singular (statically
 indeterminate sticking: only the sum of some impulses is determined). When the singular
 system's solutions form a line (two contacts on a 3-DOF body: W has rank 3), the point of
 the line nearest the least-norm one that meets the mode's inequalities is taken instead: the
@@ -20,11 +21,19 @@ returned.
 """
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
+from .._jit import jit
 from ._common import RESIDUAL_FLOOR, make_solution
+from ..validation import InputError
+from .kernel_base import (
+    KERNEL_NO_CONVERGENCE,
+    KERNEL_NONFINITE,
+    KERNEL_SOLVED,
+    KERNEL_TOO_LARGE,
+    all_finite,
+    step_residual,
+)
 from .problem import InfeasibleProblem, PlanarFrictionProblem
 
 OPEN, STICK, SLIP_POS, SLIP_NEG = range(4)
@@ -32,6 +41,9 @@ MODE_NAMES = ("open", "stick", "slip+", "slip-")
 
 # Default acceptance: complementarity_residual ≤ ACCEPT_TOL · scale (see enumerate_modes).
 ACCEPT_TOL = 1e-9
+
+# Relative singular-value cut-off of the pseudo-inverse (singular W).
+RCOND = 1e-12
 
 # Enumeration grows as 4^n_c; beyond this it is no longer a "tiny problem" solver.
 MAX_CONTACTS = 4
@@ -43,123 +55,238 @@ def _mode_table(n_contacts: int) -> np.ndarray:
     """All mode combinations, shape (4^n_c, n_c), in a fixed order (open first)."""
     table = _mode_table_cache.get(n_contacts)
     if table is None:
-        table = np.array(list(itertools.product(range(4), repeat=n_contacts)), dtype=int)
-        _mode_table_cache[n_contacts] = table
+        table = _mode_table_cache[n_contacts] = enum_table(n_contacts)
     return table
 
 
-def _mode_systems(problem: PlanarFrictionProblem, modes: np.ndarray):
-    """Stack of linear systems A p = b, one per mode combination (rows of ``modes``)."""
-    W, q = problem.W, problem.q
+@jit
+def _mode_system(W, q, lo, hi, modes, A, b):
+    """The linear system A p = b of one mode combination (module docstring), in place."""
     n = q.shape[0]
-    K = modes.shape[0]
-    A = np.zeros((K, n, n))
-    b = np.zeros((K, n))
-    identity = np.eye(n)
-    for i in range(problem.n_contacts):
-        N, T = 2 * i, 2 * i + 1
-        mode = modes[:, i]
-        contact = mode != OPEN
-        # normal row: u_N = 0 unless open (then p_N = 0)
-        A[contact, N] = W[N]
-        b[contact, N] = -q[N]
-        A[~contact, N] = identity[N]
-        # tangential row
-        A[mode == OPEN, T] = identity[T]
-        A[mode == STICK, T] = W[T]
-        b[mode == STICK, T] = -q[T]
-        for slip, bound in ((SLIP_POS, problem.lo[i]), (SLIP_NEG, problem.hi[i])):
-            row = identity[T] - bound * identity[N]
-            A[mode == slip, T] = row
-    return A, b
+    A[:, :] = 0.0
+    b[:] = 0.0
+    for i in range(modes.shape[0]):
+        N = 2 * i
+        T = N + 1
+        mode = modes[i]
+        if mode == OPEN:
+            A[N, N] = 1.0  # p_N = 0, p_T = 0
+            A[T, T] = 1.0
+            continue
+        for j in range(n):  # u_N = 0
+            A[N, j] = W[N, j]
+        b[N] = -q[N]
+        if mode == STICK:  # u_T = 0
+            for j in range(n):
+                A[T, j] = W[T, j]
+            b[T] = -q[T]
+        else:  # p_T = bound · p_N
+            A[T, T] = 1.0
+            A[T, N] = -(lo[i] if mode == SLIP_POS else hi[i])
 
 
-def _mode_inequalities(problem: PlanarFrictionProblem, modes: np.ndarray):
-    """Stack of inequalities G p + h ≥ 0 each mode combination still needs (3 per contact;
-    unused rows are 0·p + 1 ≥ 0)."""
-    W, q = problem.W, problem.q
+@jit
+def _mode_inequalities(W, q, lo, hi, modes, G, h):
+    """G p + h ≥ 0: what the mode combination still needs, 3 rows per contact (unused rows
+    are 0·p + 1 ≥ 0), in place."""
     n = q.shape[0]
-    K = modes.shape[0]
-    G = np.zeros((K, 3 * problem.n_contacts, n))
-    h = np.zeros((K, 3 * problem.n_contacts))
+    G[:, :] = 0.0
     h[:] = 1.0
-    for i in range(problem.n_contacts):
-        N, T = 2 * i, 2 * i + 1
+    for i in range(modes.shape[0]):
+        N = 2 * i
+        T = N + 1
         r = 3 * i
-        mode = modes[:, i]
-        is_open, stick = mode == OPEN, mode == STICK
-        G[is_open, r] = W[N]  # u_N ≥ 0
-        h[is_open, r] = q[N]
-        G[~is_open, r, N] = 1.0  # p_N ≥ 0
-        h[~is_open, r] = 0.0
-        G[stick, r + 1, T], G[stick, r + 1, N] = 1.0, -problem.lo[i]  # p_T − lo p_N ≥ 0
-        G[stick, r + 2, T], G[stick, r + 2, N] = -1.0, problem.hi[i]  # hi p_N − p_T ≥ 0
-        h[stick, r + 1 : r + 3] = 0.0
-        for slip, sign in ((SLIP_POS, 1.0), (SLIP_NEG, -1.0)):  # ±u_T ≥ 0
-            G[mode == slip, r + 1] = sign * W[T]
-            h[mode == slip, r + 1] = sign * q[T]
-    return G, h
+        mode = modes[i]
+        if mode == OPEN:  # u_N ≥ 0
+            for j in range(n):
+                G[r, j] = W[N, j]
+            h[r] = q[N]
+        else:  # p_N ≥ 0
+            G[r, N] = 1.0
+            h[r] = 0.0
+        if mode == STICK:  # p_T − lo p_N ≥ 0, hi p_N − p_T ≥ 0
+            G[r + 1, T] = 1.0
+            G[r + 1, N] = -lo[i]
+            G[r + 2, T] = -1.0
+            G[r + 2, N] = hi[i]
+            h[r + 1] = 0.0
+            h[r + 2] = 0.0
+        elif mode == SLIP_POS or mode == SLIP_NEG:  # ±u_T ≥ 0
+            sign = 1.0 if mode == SLIP_POS else -1.0
+            for j in range(n):
+                G[r + 1, j] = sign * W[T, j]
+            h[r + 1] = sign * q[T]
 
 
-def _solve_modes(problem, modes, rcond):
-    """Least-norm solution of every mode system, then, where the system is singular with a
-    one-dimensional null space (statically indeterminate or wedged contacts), the point of
-    that line closest to it which satisfies the mode's inequalities, if there is one."""
-    A, b = _mode_systems(problem, modes)
+@jit
+def _least_norm(U, S_inv, Vt, rhs):
+    """Vᵀᵀ diag(S_inv) Uᵀ rhs: the pseudo-inverse applied to rhs."""
+    return Vt.T @ (S_inv * (U.T @ rhs))
+
+
+@jit
+def _solve_mode(W, q, lo, hi, modes, rcond, A, b, G, h):
+    """Least-norm solution of one mode's system, moved along a one-dimensional null space to
+    the nearest point meeting the mode's inequalities (module docstring)."""
+    _mode_system(W, q, lo, hi, modes, A, b)
     U, S, Vt = np.linalg.svd(A)
-    cutoff = rcond * S[:, :1]
-    S_inv = np.where(S > cutoff, 1.0 / np.where(S > cutoff, S, 1.0), 0.0)
-
-    def least_norm(rhs):
-        return np.einsum("kji,kj->ki", Vt, S_inv * np.einsum("kji,kj->ki", U, rhs))
-
-    P = least_norm(b)
+    cutoff = rcond * S[0]
+    S_inv = np.zeros(S.shape[0])
+    null_dimension = 0
+    for k in range(S.shape[0]):
+        if S[k] > cutoff:
+            S_inv[k] = 1.0 / S[k]
+        else:
+            null_dimension += 1
+    P = _least_norm(U, S_inv, Vt, b)
     # one step of iterative refinement: near-singular systems lose digits in the first solve
-    P += least_norm(b - np.einsum("kij,kj->ki", A, P))
-    line = np.flatnonzero(np.sum(S <= cutoff, axis=1) == 1)
-    if line.size:
-        G, h = _mode_inequalities(problem, modes[line])
-        direction = Vt[line, -1]  # null vector
-        slope = np.einsum("kij,kj->ki", G, direction)
-        value = np.einsum("kij,kj->ki", G, P[line]) + h
-        # slope·t + value ≥ 0 bounds t from below (slope > 0) or above (slope < 0)
-        steep = np.abs(slope) > 1e-12 * np.maximum(np.abs(G).sum(axis=2), 1e-300)
-        bound = np.where(steep, -value / np.where(steep, slope, 1.0), 0.0)
-        t_low = np.where(steep & (slope > 0), bound, -np.inf).max(axis=1)
-        t_high = np.where(steep & (slope < 0), bound, np.inf).min(axis=1)
-        feasible = t_low <= t_high
-        t = np.where(feasible, np.clip(0.0, t_low, t_high), 0.0)
-        P[line] += t[:, None] * direction
+    P += _least_norm(U, S_inv, Vt, b - A @ P)
+    if null_dimension == 1:
+        _mode_inequalities(W, q, lo, hi, modes, G, h)
+        direction = Vt[Vt.shape[0] - 1].copy()
+        slope = G @ direction
+        value = G @ P + h
+        t_low = -np.inf
+        t_high = np.inf
+        for r in range(G.shape[0]):
+            # slope·t + value ≥ 0 bounds t from below (slope > 0) or above (slope < 0)
+            if abs(slope[r]) > 1e-12 * max(np.abs(G[r]).sum(), 1e-300):
+                if slope[r] > 0.0:
+                    t_low = max(t_low, -value[r] / slope[r])
+                else:
+                    t_high = min(t_high, -value[r] / slope[r])
+        if t_low <= t_high:
+            P += min(max(0.0, t_low), t_high) * direction
     return P
 
 
-def _batched_residuals(problem: PlanarFrictionProblem, P: np.ndarray) -> np.ndarray:
-    """complementarity_residual of every row of P (same formula, vectorised)."""
-    U = P @ problem.W.T + problem.q
-    pN, pT, uN, uT = P[:, 0::2], P[:, 1::2], U[:, 0::2], U[:, 1::2]
-    pN_pos = np.maximum(pN, 0.0)
-    projected = np.clip(pT - uT, problem.lo * pN_pos, problem.hi * pN_pos)
-    r = np.maximum(np.abs(np.minimum(pN, uN)), np.abs(pT - projected))
-    return r.max(axis=1), U
+@jit
+def solve_mode_table(W, q, lo, hi, table, rcond):
+    """`_solve_mode` for every row of ``table`` (mode combinations): P, shape (K, 2 n_c)."""
+    n = q.shape[0]
+    A = np.zeros((n, n))
+    b = np.zeros(n)
+    G = np.zeros((3 * (n // 2), n))
+    h = np.zeros(3 * (n // 2))
+    P = np.zeros((table.shape[0], n))
+    for k in range(table.shape[0]):
+        P[k] = _solve_mode(W, q, lo, hi, table[k], rcond, A, b, G, h)
+    return P
+
+
+@jit
+def enum_candidates(W, q, lo, hi, table, rcond):
+    """(P, U, residuals, scales) of every mode combination's solution.
+
+    Each candidate is judged against the velocities and the problem's own impulse scale
+    ‖q‖/max|W|, not against its own ‖p‖: on wedged contacts a singular mode admits
+    self-equilibrated impulses of any size, and ‖p‖ ~ 1e10 must not buy a lax tolerance.
+    """
+    P = solve_mode_table(W, q, lo, hi, table, rcond)
+    K = P.shape[0]
+    U = np.zeros_like(P)
+    residuals = np.zeros(K)
+    scales = np.zeros(K)
+    q_norm = np.abs(q).max()
+    W_norm = np.abs(W).max()
+    floor = max(q_norm, q_norm / W_norm if W_norm > 0.0 else 0.0)
+    for k in range(K):
+        residuals[k] = step_residual(W, q, lo, hi, P[k], U[k])
+        scale = max(np.abs(U[k]).max(), floor)
+        scales[k] = scale if scale > 0.0 else 1.0
+    return P, U, residuals, scales
+
+
+@jit
+def _mode_row(k, n_contacts):
+    """Combination k of the table's order (itertools.product: the first contact varies slowest)."""
+    modes = np.zeros(n_contacts, dtype=np.int64)
+    for i in range(n_contacts - 1, -1, -1):
+        modes[i] = k % 4
+        k //= 4
+    return modes
+
+
+@jit
+def enum_table(n_contacts):
+    """All 4^n_c mode combinations as rows (same order as `_mode_table`)."""
+    table = np.zeros((4**n_contacts, n_contacts), dtype=np.int64)
+    for k in range(table.shape[0]):
+        table[k] = _mode_row(k, n_contacts)
+    return table
+
+
+@jit
+def choose_candidate(residuals, scales, P, rtol):
+    """Index of the returned candidate (−1 if none valid) and the number of valid ones.
+
+    Among the valid candidates (residual ≤ rtol·scale) keep those as exact as the best one
+    (a candidate of a wrong mode can pass `rtol` when an interval end is within rtol of
+    another, e.g. lo = −1e-10), then the least-norm one (stable where the solution is not
+    unique; the first in table order on ties).
+    """
+    best_relative = np.inf
+    n_valid = 0
+    for k in range(residuals.shape[0]):
+        if residuals[k] <= rtol * scales[k] + RESIDUAL_FLOOR:
+            n_valid += 1
+            best_relative = min(best_relative, residuals[k] / scales[k])
+    chosen = -1
+    chosen_norm = np.inf
+    for k in range(residuals.shape[0]):
+        relative = residuals[k] / scales[k]
+        valid = residuals[k] <= rtol * scales[k] + RESIDUAL_FLOOR
+        if valid and relative <= max(100.0 * best_relative, 1e-14):
+            norm = (P[k] * P[k]).sum()
+            if norm < chosen_norm:
+                chosen, chosen_norm = k, norm
+    return chosen, n_valid
+
+
+@jit
+def enum_interval(W, q, lo, hi, p, u, rtol, max_contacts):
+    """The enumeration kernel: fills p, u; returns (status, combinations, residual).
+
+    KERNEL_TOO_LARGE beyond ``max_contacts`` (≤ 0: MAX_CONTACTS) contacts,
+    KERNEL_NO_CONVERGENCE when no combination satisfies the step law within rtol (≤ 0: ACCEPT_TOL).
+    """
+    n_contacts = lo.shape[0]
+    limit = max_contacts if max_contacts > 0 else MAX_CONTACTS
+    if n_contacts > limit:
+        return KERNEL_TOO_LARGE, 0, np.inf
+    if not (all_finite(W) and all_finite(q) and all_finite(lo) and all_finite(hi)):
+        p[:] = 0.0
+        u[:] = q
+        return KERNEL_NONFINITE, 0, np.inf
+    table = enum_table(n_contacts)
+    P, U, residuals, scales = enum_candidates(W, q, lo, hi, table, RCOND)
+    chosen, n_valid = choose_candidate(residuals, scales, P, rtol if rtol > 0.0 else ACCEPT_TOL)
+    if chosen < 0:
+        p[:] = 0.0
+        u[:] = q
+        return KERNEL_NO_CONVERGENCE, table.shape[0], residuals.min()
+    p[:] = P[chosen]
+    u[:] = U[chosen]
+    return KERNEL_SOLVED, table.shape[0], residuals[chosen]
+
+
+def _solve_modes(problem, modes, rcond):
+    """Solutions of the given mode combinations (rows of ``modes``), shape (K, 2 n_c)."""
+    table = np.ascontiguousarray(modes, dtype=np.int64).reshape(len(modes), problem.n_contacts)
+    return solve_mode_table(problem.W, problem.q, problem.lo, problem.hi, table, float(rcond))
 
 
 def _candidates(problem: PlanarFrictionProblem, rcond: float):
-    """(modes, P, U, residuals, scales) for every mode combination's least-norm solution."""
+    """(modes, P, U, residuals, scales) for every mode combination's solution."""
+    if not all(all_finite(getattr(problem, name)) for name in ("W", "q", "lo", "hi")):
+        raise InputError("enum: the problem's W, q, lo, hi must be finite")  # changed after it was made
     modes = _mode_table(problem.n_contacts)
-    P = _solve_modes(problem, modes, rcond)
-    residuals, U = _batched_residuals(problem, P)
-    # Judge each candidate against the velocities and the problem's own impulse scale
-    # ‖q‖/max|W|, not against its own ‖p‖: on wedged contacts a singular mode admits
-    # self-equilibrated impulses of any size, and ‖p‖ ~ 1e10 must not buy a lax tolerance.
-    q_norm = float(np.abs(problem.q).max())
-    W_norm = float(np.abs(problem.W).max())
-    impulse_scale = q_norm / W_norm if W_norm > 0.0 else 0.0
-    scales = np.maximum(np.abs(U).max(axis=1), max(q_norm, impulse_scale))
-    scales[scales == 0.0] = 1.0
+    P, U, residuals, scales = enum_candidates(problem.W, problem.q, problem.lo, problem.hi, modes,
+                                              float(rcond))
     return modes, P, U, residuals, scales
 
 
-def mode_solutions(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, rcond: float = 1e-12):
+def mode_solutions(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, rcond: float = RCOND):
     """Every mode combination whose least-norm solution satisfies the step law.
 
     Returns a list of (modes, p, u), modes a tuple of "open" | "stick" | "slip+" | "slip-".
@@ -176,12 +303,12 @@ def mode_solutions(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, r
 
 def _check_size(problem):
     if problem.n_contacts > MAX_CONTACTS:
-        raise ValueError(
+        raise InputError(
             f"enum: {problem.n_contacts} contacts exceed the enumeration limit of {MAX_CONTACTS}"
         )
 
 
-def enumerate_modes(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, rcond: float = 1e-12):
+def enumerate_modes(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, rcond: float = RCOND):
     """Solve the step by trying every mode combination; return a ContactSolution ("enum").
 
     ``tol``: a candidate is accepted when complementarity_residual ≤ tol · scale, scale =
@@ -198,24 +325,17 @@ def enumerate_modes(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, 
     if problem.n_contacts == 0:
         return make_solution(problem, np.zeros(0), problem.q.copy(), "enum", 0, 0.0)
     modes, P, U, residuals, scales = _candidates(problem, rcond)
-    valid = np.flatnonzero(residuals <= tol * scales + RESIDUAL_FLOOR)
-    if valid.size == 0:
+    k, n_valid = choose_candidate(residuals, scales, P, float(tol))
+    if k < 0:
         best = int(np.argmin(residuals / scales))
         raise InfeasibleProblem(
             f"enum: none of the {len(modes)} mode combinations satisfies the step law; best "
             f"{[MODE_NAMES[m] for m in modes[best]]} with residual {residuals[best]:.3e} "
             f"(> {tol:.0e} × scale {scales[best]:.3e})"
         )
-    # Among the valid candidates keep those as exact as the best one (a candidate of a wrong
-    # mode can pass `tol` when an interval end is within tol of another, e.g. lo = −1e-10),
-    # then the least-norm one (stable choice where the solution is not unique).
-    relative = residuals[valid] / scales[valid]
-    exact = valid[relative <= max(100.0 * relative.min(), 1e-14)]
-    norms = np.einsum("ki,ki->k", P[exact], P[exact])
-    k = int(exact[np.argmin(norms)])
     return make_solution(
         problem, P[k], U[k], "enum", len(modes), float(residuals[k]),
-        modes=[MODE_NAMES[m] for m in modes[k]], n_solutions=int(valid.size),
+        modes=[MODE_NAMES[m] for m in modes[k]], n_solutions=int(n_valid),
     )
 
 

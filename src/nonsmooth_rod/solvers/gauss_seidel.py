@@ -12,15 +12,34 @@ and its exact local solution is the first consistent case of
     slip   p_T = lo·p_N (needs u_T ≥ 0) or p_T = hi·p_N (needs u_T ≤ 0),
            p_N from the normal row u_N = 0: p_N = −v_N / (a + b·bound), needs a + b·bound > 0.
 
-Convergence is judged on the common residual: stop when complementarity_residual ≤
-tol · residual_scale (max-norm of p, u, q) after a sweep. With one contact the first sweep is
-exact. Plain Python floats: for 1–2 contacts they beat numpy calls by a wide margin.
+The Delassus matrix is held block-sparse (CSR over contacts, 2×2 blocks: `dense_to_blocks`),
+so a sweep costs O(nonzero blocks), i.e. O(contacts) for a chain or a row of bodies.
+
+Convergence is judged on the common residual relative to the problem's scale
+max(‖q‖∞, ‖p‖∞, ‖u‖∞): stop when complementarity_residual ≤ rtol · scale. By default the
+sweeps aim for PGS_RTOL, and when the residual stalls above it (it drops by less than
+1 − STALL_FACTOR over STALL_SWEEPS sweeps) but is already within the acceptance every exact
+solver uses (DEFAULT_RTOL, as Lemke's and enum's), they stop there and the answer is accepted: with a singular W and a q a little outside
+its range (two contacts on one body, gap-keeping terms), the exact solution has a slip
+velocity of ~1e-11 that Gauss–Seidel approaches by a drift along W's null space, 1e9 sweeps
+away (the rod at ball B's impact, issue 9). With one contact the first sweep is exact.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ._common import RESIDUAL_FLOOR, make_solution, relative_floor, velocities_and_residual
+from .._jit import jit
+from ._common import make_solution, require_finite_array
+from ..validation import InputError
+from .kernel_base import (
+    DEFAULT_RTOL,
+    KERNEL_NO_CONVERGENCE,
+    KERNEL_NONFINITE,
+    KERNEL_SOLVED,
+    all_finite,
+    contact_residual,
+    problem_scale,
+)
 from .problem import NoConvergence, PlanarFrictionProblem
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
@@ -29,77 +48,215 @@ from .problem import NoConvergence, PlanarFrictionProblem
 SINGULAR_DET = 1e-13
 # Round-off slack of the local consistency tests (relative to the quantities compared).
 LOCAL_SLACK = 1e-12
+# Default target of the sweeps (relative) and sweep limit.
+PGS_RTOL = 1e-12
+PGS_MAX_SWEEPS = 10000
+# Stall detection: over STALL_SWEEPS sweeps the residual fell by less than STALL_FACTOR.
+# A linear rate that slow (ρ > 0.9998) would need > 3·10⁴ sweeps per factor 10³ anyway.
+STALL_SWEEPS = 50
+STALL_FACTOR = 0.99
 
 
-def solve_contact(a, b, c, v_n, v_t, lo, hi):
-    """Exact solution (p_N, p_T) of one contact's 2×2 problem, or None when no case fits.
+@jit
+def local_contact_solve(a, b, c, v_n, v_t, lo, hi):
+    """Exact solution of one contact's 2×2 problem: (found, p_N, p_T).
 
     The cases are tried in the order open, stick, slip at lo, slip at hi; the first that is
     consistent is returned (for an ill-posed local problem with several solutions this is
-    the one Gauss–Seidel keeps).
+    the one Gauss–Seidel keeps). found is False when no case fits.
     """
     if v_n >= 0.0:
-        return 0.0, 0.0
+        return True, 0.0, 0.0
     det = a * c - b * b
     if det > SINGULAR_DET * a * c:
         p_n = (-c * v_n + b * v_t) / det
         p_t = (b * v_n - a * v_t) / det
         slack = LOCAL_SLACK * (abs(p_n) + abs(p_t))
         if p_n >= 0.0 and lo * p_n - slack <= p_t <= hi * p_n + slack:
-            return p_n, min(max(p_t, lo * p_n), hi * p_n)
-    for bound, sign in ((lo, 1.0), (hi, -1.0)):
+            return True, p_n, min(max(p_t, lo * p_n), hi * p_n)
+    for k in range(2):
+        bound = lo if k == 0 else hi
+        sign = 1.0 if k == 0 else -1.0
         normal_stiffness = a + b * bound
         if normal_stiffness > 0.0:
             p_n = -v_n / normal_stiffness
             u_t = (b + c * bound) * p_n + v_t
             if sign * u_t >= -LOCAL_SLACK * (abs(v_t) + abs((b + c * bound) * p_n)):
-                return p_n, bound * p_n
-    return None
+                return True, p_n, bound * p_n
+    return False, 0.0, 0.0
+
+
+def solve_contact(a, b, c, v_n, v_t, lo, hi):
+    """`local_contact_solve` as (p_N, p_T), or None when no case fits."""
+    found, p_n, p_t = local_contact_solve(float(a), float(b), float(c), float(v_n), float(v_t),
+                                          float(lo), float(hi))
+    return (float(p_n), float(p_t)) if found else None
+
+
+@jit
+def dense_to_blocks(W):
+    """CSR over contacts of the 2×2 blocks of W: (indptr, indices, blocks).
+
+    Blocks that are exactly zero are left out, except the diagonal ones (always present).
+    """
+    na = W.shape[0] // 2
+    indptr = np.zeros(na + 1, dtype=np.int64)
+    for i in range(na):
+        count = 0
+        for j in range(na):
+            if i == j or _block_nonzero(W, i, j):
+                count += 1
+        indptr[i + 1] = indptr[i] + count
+    indices = np.zeros(indptr[na], dtype=np.int64)
+    blocks = np.zeros((indptr[na], 2, 2))
+    for i in range(na):
+        k = indptr[i]
+        for j in range(na):
+            if i == j or _block_nonzero(W, i, j):
+                indices[k] = j
+                for r in range(2):
+                    for s in range(2):
+                        blocks[k, r, s] = W[2 * i + r, 2 * j + s]
+                k += 1
+    return indptr, indices, blocks
+
+
+@jit
+def _block_nonzero(W, i, j):
+    return (W[2 * i, 2 * j] != 0.0 or W[2 * i, 2 * j + 1] != 0.0
+            or W[2 * i + 1, 2 * j] != 0.0 or W[2 * i + 1, 2 * j + 1] != 0.0)
+
+
+@jit
+def block_velocities(indptr, indices, blocks, q, p, u):
+    """u = W p + q for the block-sparse W, in place (O(nonzero blocks))."""
+    for i in range(indptr.shape[0] - 1):
+        u_n = q[2 * i]
+        u_t = q[2 * i + 1]
+        for k in range(indptr[i], indptr[i + 1]):
+            j = indices[k]
+            u_n += blocks[k, 0, 0] * p[2 * j] + blocks[k, 0, 1] * p[2 * j + 1]
+            u_t += blocks[k, 1, 0] * p[2 * j] + blocks[k, 1, 1] * p[2 * j + 1]
+        u[2 * i] = u_n
+        u[2 * i + 1] = u_t
+
+
+@jit
+def _diagonal_positions(indptr, indices):
+    """Position in `blocks` of each contact's diagonal block (−1 if missing)."""
+    na = indptr.shape[0] - 1
+    diagonal = np.full(na, -1, dtype=np.int64)
+    for i in range(na):
+        for k in range(indptr[i], indptr[i + 1]):
+            if indices[k] == i:
+                diagonal[i] = k
+    return diagonal
+
+
+@jit
+def pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p):
+    """One Gauss–Seidel sweep over the contacts, updating p in place."""
+    for i in range(indptr.shape[0] - 1):
+        v_n = q[2 * i]
+        v_t = q[2 * i + 1]
+        for k in range(indptr[i], indptr[i + 1]):
+            j = indices[k]
+            if j != i:
+                v_n += blocks[k, 0, 0] * p[2 * j] + blocks[k, 0, 1] * p[2 * j + 1]
+                v_t += blocks[k, 1, 0] * p[2 * j] + blocks[k, 1, 1] * p[2 * j + 1]
+        d = diagonal[i]
+        found, p_n, p_t = local_contact_solve(blocks[d, 0, 0], blocks[d, 0, 1], blocks[d, 1, 1],
+                                              v_n, v_t, lo[i], hi[i])
+        if found:
+            p[2 * i] = p_n
+            p[2 * i + 1] = p_t
+
+
+@jit
+def pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps):
+    """Nonsmooth Gauss–Seidel on a block-sparse Delassus; p is the warm start.
+
+    Fills p, u in place; returns (status, sweeps, residual) with the `kernels` status codes.
+    Stops at residual ≤ rtol·scale. rtol ≤ 0 is the default: aim for PGS_RTOL, and accept a
+    stalled residual ≤ DEFAULT_RTOL·scale (module docstring). max_sweeps ≤ 0: PGS_MAX_SWEEPS.
+    """
+    if not (all_finite(blocks) and all_finite(q) and all_finite(lo) and all_finite(hi) and all_finite(p)):
+        p[:] = 0.0
+        u[:] = q
+        return KERNEL_NONFINITE, 0, np.inf
+    diagonal = _diagonal_positions(indptr, indices)
+    for i in range(diagonal.shape[0]):
+        if diagonal[i] < 0:  # the local solve needs W_ii: a malformed matrix cannot converge
+            return KERNEL_NO_CONVERGENCE, 0, np.inf
+    target = rtol if rtol > 0.0 else PGS_RTOL
+    accept = rtol if rtol > 0.0 else DEFAULT_RTOL
+    limit = max_sweeps if max_sweeps > 0 else PGS_MAX_SWEEPS
+    history = np.full(STALL_SWEEPS, np.inf)
+    residual = np.inf
+    for sweep in range(1, limit + 1):
+        pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p)
+        block_velocities(indptr, indices, blocks, q, p, u)
+        residual = contact_residual(lo, hi, p, u)
+        scale = problem_scale(q, p, u)
+        if residual <= target * scale + 1e-300:
+            return KERNEL_SOLVED, sweep, residual
+        slot = sweep % STALL_SWEEPS
+        stalled = residual > STALL_FACTOR * history[slot]
+        history[slot] = residual
+        if stalled and residual <= accept * scale:
+            return KERNEL_SOLVED, sweep, residual
+    return KERNEL_NO_CONVERGENCE, limit, residual
+
+
+@jit
+def pgs_dense(W, q, lo, hi, p, u, rtol, max_sweeps):
+    """`pgs_block` on a dense W (converted once per call, O(contacts²))."""
+    if not all_finite(W):
+        p[:] = 0.0
+        u[:] = q
+        return KERNEL_NONFINITE, 0, np.inf
+    indptr, indices, blocks = dense_to_blocks(W)
+    return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps)
 
 
 def projected_gauss_seidel(
     problem: PlanarFrictionProblem,
     *,
-    tol: float = 1e-12,
-    max_iter: int = 10000,
+    tol: float | None = None,
+    max_iter: int = PGS_MAX_SWEEPS,
     p0=None,
 ):
     """Solve the step by nonsmooth Gauss–Seidel sweeps; return a ContactSolution ("pgs").
 
     ``tol``: stop when complementarity_residual ≤ tol · residual_scale (checked after each
-    sweep). ``max_iter``: sweep limit; reaching it raises NoConvergence naming the sweeps and
-    the residual. ``p0``: warm start (e.g. the previous step's impulses); default zero.
-    iterations = sweeps.
+    sweep). Default (None): aim for PGS_RTOL and accept a stalled residual within
+    DEFAULT_RTOL · scale, the acceptance of Lemke and enum (module docstring). ``max_iter``: sweep limit; reaching it raises NoConvergence naming the sweeps
+    and the residual. ``p0``: warm start (e.g. the previous step's impulses); default zero.
+    iterations = sweeps. Runs the compiled `pgs_block` kernel (interpreted without numba).
     """
-    W = problem.W.tolist()
-    q = problem.q.tolist()
-    lo = problem.lo.tolist()
-    hi = problem.hi.tolist()
-    n_c = problem.n_contacts
-    p = [0.0] * (2 * n_c) if p0 is None else [float(x) for x in np.asarray(p0, dtype=float).ravel()]
-    if len(p) != 2 * n_c:
-        raise ValueError(f"pgs: warm start has {len(p)} entries, the problem has {2 * n_c}")
-    local = [(W[2 * i][2 * i], W[2 * i][2 * i + 1], W[2 * i + 1][2 * i + 1]) for i in range(n_c)]
-    u, residual = velocities_and_residual(W, q, lo, hi, p)
-    for sweep in range(1, max_iter + 1):
-        for i in range(n_c):
-            N, T = 2 * i, 2 * i + 1
-            a, b, c = local[i]
-            p_n, p_t = p[N], p[T]
-            W_n, W_t = W[N], W[T]
-            v_n = q[N] + sum(w * x for w, x in zip(W_n, p)) - a * p_n - b * p_t
-            v_t = q[T] + sum(w * x for w, x in zip(W_t, p)) - b * p_n - c * p_t
-            solution = solve_contact(a, b, c, v_n, v_t, lo[i], hi[i])
-            if solution is not None:
-                p[N], p[T] = solution
-        u, residual = velocities_and_residual(W, q, lo, hi, p)
-        scale = relative_floor(p, u, q)
-        if residual <= tol * scale + RESIDUAL_FLOOR:
-            return make_solution(problem, p, u, "pgs", sweep, residual)
-    raise NoConvergence(
-        f"pgs: no convergence after {max_iter} sweeps, residual {residual:.3e} > "
-        f"tol {tol:.0e} × scale {relative_floor(p, u, q):.3e}"
-    )
+    n = 2 * problem.n_contacts
+    p = np.zeros(n) if p0 is None else np.array(p0, dtype=float).ravel()
+    if p.shape[0] != n:
+        raise InputError(f"pgs: warm start has {p.shape[0]} entries, the problem has {n}")
+    require_finite_array("p0", p, "pgs")
+    u = problem.q.copy()
+    if n == 0:
+        return make_solution(problem, p, u, "pgs", 0, 0.0)
+    rtol = 0.0 if tol is None else float(tol)
+    status, sweeps, residual = pgs_dense(problem.W, problem.q, problem.lo, problem.hi, p, u, rtol,
+                                         int(max_iter))
+    if status == KERNEL_NONFINITE:  # only if the problem's arrays were changed after it was made
+        raise InputError("pgs: the problem's W, q, lo, hi must be finite")
+    if status != KERNEL_SOLVED:
+        scale = max(np.abs(p).max(), np.abs(u).max(), np.abs(problem.q).max()) or 1.0
+        raise NoConvergence(
+            f"pgs: no convergence after {sweeps} sweeps, residual {residual:.3e} > "
+            f"tol {rtol or PGS_RTOL:.0e} × scale {scale:.3e}"
+        )
+    return make_solution(problem, p, u, "pgs", int(sweeps), float(residual))
 
 
-__all__ = ["projected_gauss_seidel", "solve_contact"]
+__all__ = [
+    "projected_gauss_seidel", "solve_contact", "local_contact_solve", "pgs_block", "pgs_dense",
+    "dense_to_blocks", "block_velocities",
+]

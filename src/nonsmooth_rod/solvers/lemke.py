@@ -39,15 +39,20 @@ step with impulses 40× the free velocity: a genuine secondary ray of the non-co
 matrix), which the cone LCP then solved. Hence ``lemke_friction`` falls back to the other
 formulation when one fails.
 
-The pivoting kernels are written once in plain Python (float loops over lists: faster than
-numpy calls for the 3–6 unknowns of a step) and compiled with numba when it is installed;
-``new_matrix``/``new_vector`` allocate lists in Python and numpy arrays under numba.
+The pivoting kernels are written once, as float loops over numpy arrays, and decorated with
+`nonsmooth_rod._jit.jit`: compiled by numba when it is installed, the same source interpreted
+otherwise (``jit=False`` runs it interpreted even where numba is present). The compiled
+Moreau–Jean loop reaches them through `kernels.solve_interval`.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ._common import RESIDUAL_FLOOR
+from .._jit import ENABLED as HAVE_NUMBA
+from .._jit import jit
+from ..validation import InputError
+from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
+from .kernel_base import step_residual
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -56,18 +61,6 @@ from .problem import (
     SolverError,
     classify_contacts,
 )
-
-try:  # numba is an optional accelerator; everything below also runs as plain Python.
-    import numba
-    from numba.extending import overload, register_jitable
-except ImportError:  # pragma: no cover - exercised only where numba is absent
-    numba = None
-
-    def register_jitable(function):
-        return function
-
-
-HAVE_NUMBA = numba is not None
 
 # Kernel status codes.
 SOLVED, RAY, PIVOT_LIMIT = 0, 1, 2
@@ -87,37 +80,7 @@ TIE_TOL = 1e-14
 RESIDUAL_TOL = 1e-9
 
 
-def new_matrix(rows, cols):
-    """Zero matrix: list of lists in plain Python (a numpy array under numba, see overload)."""
-    return [[0.0] * cols for _ in range(rows)]
-
-
-def new_vector(size):
-    """Zero float vector (list in plain Python, numpy array under numba)."""
-    return [0.0] * size
-
-
-def new_index(size):
-    """Index vector 0..size−1 (list in plain Python, numpy int array under numba)."""
-    return list(range(size))
-
-
-if HAVE_NUMBA:
-
-    @overload(new_matrix)
-    def _new_matrix_numba(rows, cols):
-        return lambda rows, cols: np.zeros((rows, cols))
-
-    @overload(new_vector)
-    def _new_vector_numba(size):
-        return lambda size: np.zeros(size)
-
-    @overload(new_index)
-    def _new_index_numba(size):
-        return lambda size: np.arange(size)
-
-
-@register_jitable
+@jit
 def _fill_tableau(T, M, q, n):
     """T = [I | −M | −d | q] with covering vector d = (1, …, 1); T must be zero on entry."""
     for i in range(n):
@@ -130,25 +93,9 @@ def _fill_tableau(T, M, q, n):
         row[2 * n + 1] = q[i]
 
 
+@jit
 def _pivot(T, r, e):
-    """Gauss–Jordan pivot of tableau T on row r, column e (plain Python: rebuilds list rows,
-    which list comprehensions do fastest; under numba the in-place loop below is used)."""
-    row = T[r]
-    inverse = 1.0 / row[e]
-    row = [x * inverse for x in row]
-    row[e] = 1.0
-    T[r] = row
-    for i, other in enumerate(T):
-        if i != r:
-            factor = other[e]
-            if factor != 0.0:
-                other = [a - factor * b for a, b in zip(other, row)]
-                other[e] = 0.0
-                T[i] = other
-
-
-def _pivot_in_place(T, r, e):
-    """Gauss–Jordan pivot of tableau T on row r, column e, in place (numba version)."""
+    """Gauss–Jordan pivot of tableau T on row r, column e, in place."""
     n_cols = T.shape[1]
     row = T[r]
     inverse = 1.0 / row[e]
@@ -165,33 +112,26 @@ def _pivot_in_place(T, r, e):
                 other[e] = 0.0
 
 
-if HAVE_NUMBA:
-
-    @overload(_pivot)
-    def _pivot_numba(T, r, e):
-        return _pivot_in_place
-
-
-@register_jitable
+@jit
 def _lex_smaller(T, i, k, e, n):
-    """Is row i's (rhs, B⁻¹ row)/T[i][e] lexicographically smaller than row k's?
+    """Is row i's (rhs, B⁻¹ row)/T[i, e] lexicographically smaller than row k's?
 
     B⁻¹ sits in the first n columns (the w columns, the identity at the start). Rows of
     B⁻¹ are independent, so in exact arithmetic two rows are never lexicographically equal:
     this is what makes the minimum-ratio choice unique and rules out cycling.
     """
-    a_i = T[i][e]
-    a_k = T[k][e]
-    x = T[i][2 * n + 1] / a_i
-    y = T[k][2 * n + 1] / a_k
+    a_i = T[i, e]
+    a_k = T[k, e]
+    x = T[i, 2 * n + 1] / a_i
+    y = T[k, 2 * n + 1] / a_k
     tol = TIE_TOL * (1.0 + abs(x) + abs(y))
     if x < y - tol:
         return True
     if x > y + tol:
         return False
     for j in range(n):
-        x = T[i][j] / a_i
-        y = T[k][j] / a_k
+        x = T[i, j] / a_i
+        y = T[k, j] / a_k
         tol = TIE_TOL * (1.0 + abs(x) + abs(y))
         if x < y - tol:
             return True
@@ -200,7 +140,7 @@ def _lex_smaller(T, i, k, e, n):
     return False
 
 
-@register_jitable
+@jit
 def _complementary_pivoting(T, basis, n, max_pivots):
     """Lemke's method on tableau T = [I | −M | −d | q]; basis[i] is the variable of row i.
 
@@ -216,7 +156,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
     r = -1
     q_min = 0.0
     for i in range(n):
-        value = T[i][rhs]
+        value = T[i, rhs]
         if value < 0.0:
             if r < 0 or value <= q_min + TIE_TOL * (1.0 + abs(q_min)):
                 r = i
@@ -234,24 +174,24 @@ def _complementary_pivoting(T, basis, n, max_pivots):
     while True:
         column_max = 1.0
         for i in range(n):
-            column_max = max(column_max, abs(T[i][entering]))
+            column_max = max(column_max, abs(T[i, entering]))
         pivot_tol = PIVOT_TOL * column_max
         r = -1
         for i in range(n):
-            if T[i][entering] > pivot_tol and (r < 0 or _lex_smaller(T, i, r, entering, n)):
+            if T[i, entering] > pivot_tol and (r < 0 or _lex_smaller(T, i, r, entering, n)):
                 r = i
         if r < 0:
             # A secondary ray — unless z0 already sits at (round-off) zero, in which case the
             # current complementary basis solves the LCP (singular W makes this happen: z0
             # reaches 0 on a degenerate pivot without being chosen to leave).
-            if T[z0_row][rhs] <= ZERO_Z0_TOL:
+            if T[z0_row, rhs] <= ZERO_Z0_TOL:
                 return SOLVED, pivots, entering
             return RAY, pivots, entering
         # If z0 ties for leaving, let it leave: that ends the method with a solution.
-        a0 = T[z0_row][entering]
+        a0 = T[z0_row, entering]
         if r != z0_row and a0 > pivot_tol:
-            ratio0 = T[z0_row][rhs] / a0
-            ratio = T[r][rhs] / T[r][entering]
+            ratio0 = T[z0_row, rhs] / a0
+            ratio = T[r, rhs] / T[r, entering]
             if ratio0 <= ratio + TIE_TOL * (1.0 + abs(ratio)):
                 r = z0_row
         if pivots >= max_pivots:
@@ -265,7 +205,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
         entering = leaving + n if leaving < n else leaving - n
 
 
-@register_jitable
+@jit
 def _basic_solution(T, basis, M, q, n, z):
     """z from the final basis, with one step of iterative refinement against the original M, q.
 
@@ -274,12 +214,12 @@ def _basic_solution(T, basis, M, q, n, z):
     pivots accumulated. Tiny negative values of round-off size are clipped to 0.
     """
     rhs = 2 * n + 1
-    residual = new_vector(n)
+    residual = np.zeros(n)
     for k in range(n):
         residual[k] = q[k]
     for i in range(n):
         v = basis[i]
-        x = T[i][rhs]
+        x = T[i, rhs]
         if v < n:
             residual[v] -= x
         elif v < 2 * n:
@@ -301,21 +241,21 @@ def _basic_solution(T, basis, M, q, n, z):
             z[v - n] = max(x, 0.0)
 
 
-@register_jitable
+@jit
 def _lemke_kernel(M, q, max_pivots):
     """Lemke on (M, q) given as rows/vector; returns (z, status, pivots, last entering)."""
     n = len(q)
-    T = new_matrix(n, 2 * n + 2)
+    T = np.zeros((n, 2 * n + 2))
     _fill_tableau(T, M, q, n)
-    basis = new_index(n)
+    basis = np.arange(n)
     status, pivots, entering = _complementary_pivoting(T, basis, n, max_pivots)
-    z = new_vector(n)
+    z = np.zeros(n)
     if status == SOLVED or status == RAY:  # at a ray z is the last point of the path
         _basic_solution(T, basis, M, q, n, z)
     return z, status, pivots, entering
 
 
-@register_jitable
+@jit
 def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
     """The 3-per-contact LCP of the module docstring, from W / w_scale and q / q_scale."""
     n_c = len(lo)
@@ -336,7 +276,7 @@ def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
         qq[3 * i + 1] = q[2 * i + 1] / q_scale
 
 
-@register_jitable
+@jit
 def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
     """The 4-per-contact (Anitescu–Potra) LCP of the module docstring, scaled likewise."""
     n_c = len(lo)
@@ -370,7 +310,7 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
         qq[4 * i + 2] = lo[i] * q[2 * i + 1] / q_scale
 
 
-@register_jitable
+@jit
 def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms).
 
@@ -392,16 +332,16 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     q_scale = q_norm if q_norm > 0.0 else 1.0
     per_contact = 3 if formulation == INTERVAL else 4
     n = per_contact * n_c
-    M = new_matrix(n, n)
-    qq = new_vector(n)
+    M = np.zeros((n, n))
+    qq = np.zeros(n)
     if formulation == INTERVAL:
         _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
     else:
         _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
     z, status, pivots, entering = _lemke_kernel(M, qq, max_pivots)
 
-    p = new_vector(2 * n_c)
-    u = new_vector(2 * n_c)
+    p = np.zeros(2 * n_c)
+    u = np.zeros(2 * n_c)
     residual = 0.0
     if status == SOLVED or status == RAY:
         to_impulse = q_scale / w_scale
@@ -412,23 +352,7 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
                 p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
             else:
                 p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
-        # u = W p + q and complementarity_residual (same formula as problem.py).
-        for i in range(2 * n_c):
-            value = q[i]
-            W_i = W[i]
-            for j in range(2 * n_c):
-                value += W_i[j] * p[j]
-            u[i] = value
-        for i in range(n_c):
-            p_n = p[2 * i]
-            p_t = p[2 * i + 1]
-            r_n = abs(min(p_n, u[2 * i]))
-            p_n_pos = max(p_n, 0.0)
-            trial = p_t - u[2 * i + 1]
-            low = lo[i] * p_n_pos
-            high = hi[i] * p_n_pos
-            projected = low if trial < low else (high if trial > high else trial)
-            residual = max(residual, r_n, abs(p_t - projected))
+        residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
     norms = (q_norm, W_norm, max(q_norm, _max_abs(p), _max_abs(u)))
     if status == RAY:
         # Wedged contacts (two normals nearly opposed, W singular) make the solution set
@@ -440,7 +364,7 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     return p, u, residual, status, pivots, norms
 
 
-@register_jitable
+@jit
 def _max_abs(values):
     largest = 0.0
     for value in values:
@@ -448,14 +372,17 @@ def _max_abs(values):
     return largest
 
 
-if HAVE_NUMBA:
-    _lemke_kernel_jit = numba.njit(cache=True)(_lemke_kernel)
-    _lemke_friction_kernel_jit = numba.njit(cache=True)(_lemke_friction_kernel)
+# Former names of the compiled kernels (fast_moreau_jean imports them).
+_lemke_kernel_jit = _lemke_kernel
+_lemke_friction_kernel_jit = _lemke_friction_kernel
 
 
-def _default_max_pivots(n: int) -> int:
+def _default_max_pivots(n):
     # Lemke typically needs O(n) pivots; exponential worst cases do not occur at n ≤ 12.
     return 50 + 20 * n
+
+
+default_max_pivots = jit(_default_max_pivots)  # for the compiled callers
 
 
 def _variable_name(index: int, n: int) -> str:
@@ -474,26 +401,16 @@ def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
     Covering vector d = (1, …, 1); lexicographic minimum-ratio rule (no cycling on degenerate
     problems); q ≥ 0 returns z = 0 after 0 pivots. M and q are normalised to max|entry| = 1
     before pivoting (the solution scales back exactly). ``jit``: use the numba kernel (default:
-    when numba is installed).
+    when numba is installed); False runs the same source interpreted.
 
-    Raises RayTermination on a secondary ray (no solution found by complementary pivoting:
-    the LCP may be infeasible, or M outside the classes Lemke is guaranteed to process) and
+    Raises InputError for M, q of inconsistent shapes or with NaN/inf entries,
+    RayTermination on a secondary ray (no solution found by complementary pivoting: the LCP
+    may be infeasible, or M outside the classes Lemke is guaranteed to process) and
     NoConvergence when ``max_pivots`` (default 50 + 20 n) is reached.
+    `nonsmooth_rod.solvers.lcp.lemke` is the same method reporting failure as a status.
     """
-    M = np.array(M, dtype=float, ndmin=2)
-    q = np.array(q, dtype=float, ndmin=1)
-    n = q.shape[0]
-    if M.shape != (n, n):
-        raise ValueError(f"lemke: M must be {n}×{n} for q of length {n}, got {M.shape}")
-    if max_pivots is None:
-        max_pivots = _default_max_pivots(n)
-    m_scale = float(np.max(np.abs(M), initial=0.0)) or 1.0
-    q_scale = float(np.max(np.abs(q), initial=0.0)) or 1.0
-    M_scaled, q_scaled = M / m_scale, q / q_scale
-    if _use_jit(jit):
-        z, status, pivots, entering = _lemke_kernel_jit(M_scaled, q_scaled, max_pivots)
-    else:
-        z, status, pivots, entering = _lemke_kernel(M_scaled.tolist(), q_scaled.tolist(), max_pivots)
+    z, status, pivots, entering, max_pivots = run_lemke(M, q, max_pivots, jit)
+    n = z.shape[0]
     if status == RAY:
         raise RayTermination(
             f"lemke: secondary ray after {pivots} pivots (entering {_variable_name(entering, n)} "
@@ -501,14 +418,41 @@ def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
         )
     if status == PIVOT_LIMIT:
         raise NoConvergence(f"lemke: pivot limit {max_pivots} reached on an LCP of size {n}")
-    return np.asarray(z, dtype=float) * (q_scale / m_scale), pivots
+    return z, pivots
+
+
+def run_lemke(M, q, max_pivots: int | None, jit: bool | None):
+    """Validate (M, q), scale, pivot: (z, status, pivots, last entering, max_pivots used)."""
+    M = _float_array("M", M, 2)
+    q = _float_array("q", q, 1)
+    n = q.shape[0]
+    if q.ndim != 1 or M.shape != (n, n):
+        raise InputError(f"lemke: M must be {n}×{n} for q of length {n}, got M {M.shape}, q {q.shape}")
+    require_finite_array("M", M, "lemke")
+    require_finite_array("q", q, "lemke")
+    if max_pivots is None:
+        max_pivots = _default_max_pivots(n)
+    if isinstance(max_pivots, bool) or not isinstance(max_pivots, (int, np.integer)) or max_pivots < 0:
+        raise InputError(f"lemke: max_pivots must be a non-negative integer, got {max_pivots!r}")
+    m_scale = float(np.max(np.abs(M), initial=0.0)) or 1.0
+    q_scale = float(np.max(np.abs(q), initial=0.0)) or 1.0
+    kernel = _lemke_kernel if _use_jit(jit) else interpreted(_lemke_kernel)
+    z, status, pivots, entering = kernel(M / m_scale, q / q_scale, int(max_pivots))
+    return np.asarray(z, dtype=float) * (q_scale / m_scale), status, pivots, entering, max_pivots
+
+
+def _float_array(name, values, ndmin):
+    try:
+        return np.array(values, dtype=float, ndmin=ndmin)
+    except (TypeError, ValueError):
+        raise InputError(f"lemke: {name} must be an array of numbers, got {values!r}") from None
 
 
 def _use_jit(jit: bool | None) -> bool:
     if jit is None:
         return HAVE_NUMBA
     if jit and not HAVE_NUMBA:
-        raise ValueError("jit=True needs numba, which is not installed")
+        raise InputError("jit=True needs numba, which is not installed")
     return jit
 
 
@@ -516,11 +460,8 @@ def _run_friction_kernel(problem, formulation, max_pivots, jit):
     code = FORMULATIONS[formulation]
     if max_pivots is None:
         max_pivots = _default_max_pivots((3 if code == INTERVAL else 4) * problem.n_contacts)
-    if jit:
-        return _lemke_friction_kernel_jit(problem.W, problem.q, problem.lo, problem.hi, max_pivots, code)
-    return _lemke_friction_kernel(
-        problem.W.tolist(), problem.q.tolist(), problem.lo.tolist(), problem.hi.tolist(), max_pivots, code
-    )
+    kernel = _lemke_friction_kernel if jit else interpreted(_lemke_friction_kernel)
+    return kernel(problem.W, problem.q, problem.lo, problem.hi, int(max_pivots), code)
 
 
 def _attempt(problem, formulation, max_pivots, tol, jit):
@@ -569,7 +510,7 @@ def lemke_friction(
     tol · residual_scale (round-off only, normally ~1e-15).
     """
     if formulation not in FORMULATIONS:
-        raise ValueError(f"lemke: unknown formulation {formulation!r}; choose from {sorted(FORMULATIONS)}")
+        raise InputError(f"lemke: unknown formulation {formulation!r}; choose from {sorted(FORMULATIONS)}")
     jit = _use_jit(jit)
     result = _attempt(problem, formulation, max_pivots, tol, jit)
     used = formulation

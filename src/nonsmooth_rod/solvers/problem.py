@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..validation import InputError
+
 
 class SolverError(RuntimeError):
     """A one-step solver could not return a solution it can vouch for."""
@@ -54,17 +56,21 @@ class PlanarFrictionProblem:
     hi: np.ndarray
 
     def __post_init__(self):
-        W = np.asarray(self.W, dtype=float)
-        q = np.asarray(self.q, dtype=float)
-        lo = np.atleast_1d(np.asarray(self.lo, dtype=float))
-        hi = np.atleast_1d(np.asarray(self.hi, dtype=float))
-        n = q.shape[0]
+        # Own copies: validated once here, they cannot turn non-finite behind the solvers'
+        # back when the caller reuses its arrays.
+        W = _float_array("W", self.W)
+        q = _float_array("q", self.q)
+        lo = np.atleast_1d(_float_array("lo", self.lo))
+        hi = np.atleast_1d(_float_array("hi", self.hi))
+        n = q.shape[0] if q.ndim == 1 else -1
         if n % 2 or W.shape != (n, n) or lo.shape != (n // 2,) or hi.shape != (n // 2,):
-            raise ValueError(
+            raise InputError(
                 f"inconsistent problem shapes: W {W.shape}, q {q.shape}, lo {lo.shape}, hi {hi.shape}"
             )
+        for name, values in (("W", W), ("q", q), ("lo", lo), ("hi", hi)):
+            _require_finite(name, values)
         if np.any(lo > 0) or np.any(hi < 0):
-            raise ValueError("friction interval must contain 0: lo ≤ 0 ≤ hi")
+            raise InputError("friction interval must contain 0: lo ≤ 0 ≤ hi")
         object.__setattr__(self, "W", W)
         object.__setattr__(self, "q", q)
         object.__setattr__(self, "lo", lo)
@@ -79,6 +85,22 @@ class PlanarFrictionProblem:
         """The ordinary one-coefficient Coulomb problem |p_T| ≤ μ p_N."""
         mu = np.atleast_1d(np.asarray(mu, dtype=float))
         return cls(W, q, -mu, mu)
+
+
+def _float_array(name: str, values) -> np.ndarray:
+    try:
+        return np.array(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be an array of numbers, got {values!r}") from None
+
+
+def _require_finite(name: str, values: np.ndarray) -> None:
+    """InputError naming the argument and its first NaN/inf entry (solvers would return NaN
+    or ±inf as a "solution", or fail inside numpy)."""
+    if values.size and not np.isfinite(values).all():
+        index = np.unravel_index(int(np.flatnonzero(~np.isfinite(values))[0]), values.shape)
+        where = int(index[0]) if len(index) == 1 else tuple(int(i) for i in index)
+        raise InputError(f"{name} must be finite, got {float(values[index])!r} at index {where}")
 
 
 @dataclass

@@ -1,0 +1,77 @@
+"""Status codes, solver codes and the small compiled helpers every solver kernel shares.
+
+`kernels` re-exports all of it (the interface the compiled loops use); the solver modules
+import it from here, below `kernels`, to avoid an import cycle.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import jit
+
+# Status codes.
+KERNEL_SOLVED = 0
+KERNEL_RAY = 1  # Lemke: no solution by complementary pivoting
+KERNEL_NO_CONVERGENCE = 2  # iteration/pivot limit, or an answer that misses the step law
+KERNEL_TOO_LARGE = 3  # enum beyond its contact limit
+KERNEL_NONFINITE = 4  # NaN/inf in the data
+
+# Solver codes.
+SOLVER_LEMKE = 0
+SOLVER_PGS = 1
+SOLVER_ENUM = 2
+SOLVER_CODES = {"lemke": SOLVER_LEMKE, "pgs": SOLVER_PGS, "enum": SOLVER_ENUM}
+STATUS_NAMES = ("solved", "ray", "no-convergence", "too-large", "non-finite")
+
+# Default acceptance (relative): the same for the three solvers, so that none of them fails
+# where another one's answer would be accepted.
+DEFAULT_RTOL = 1e-9  # = lemke.RESIDUAL_TOL and enumeration.ACCEPT_TOL
+
+
+@jit
+def all_finite(values) -> bool:
+    """True when no entry of the (flattened) array is NaN or ±inf."""
+    for x in values.ravel():
+        if not np.isfinite(x):
+            return False
+    return True
+
+
+@jit
+def step_residual(W, q, lo, hi, p, u):
+    """u = W p + q in place; return the complementarity residual (problem.py's formula)."""
+    m = q.shape[0]
+    for i in range(m):
+        value = q[i]
+        for j in range(m):
+            value += W[i, j] * p[j]
+        u[i] = value
+    return contact_residual(lo, hi, p, u)
+
+
+@jit
+def contact_residual(lo, hi, p, u):
+    """max over contacts of |min(p_N, u_N)| and |p_T − proj_[lo p_N⁺, hi p_N⁺](p_T − u_T)|."""
+    residual = 0.0
+    for i in range(lo.shape[0]):
+        p_n = p[2 * i]
+        p_t = p[2 * i + 1]
+        r_n = abs(min(p_n, u[2 * i]))
+        p_n_pos = max(p_n, 0.0)
+        trial = p_t - u[2 * i + 1]
+        low = lo[i] * p_n_pos
+        high = hi[i] * p_n_pos
+        projected = low if trial < low else (high if trial > high else trial)
+        residual = max(residual, r_n, abs(p_t - projected))
+    return residual
+
+
+@jit
+def problem_scale(q, p, u) -> float:
+    """max(‖q‖∞, ‖p‖∞, ‖u‖∞), or 1 when all vanish: what a relative tolerance multiplies."""
+    scale = 0.0
+    for i in range(q.shape[0]):
+        scale = max(scale, abs(q[i]), abs(p[i]), abs(u[i]))
+    return scale if scale > 0.0 else 1.0
+
+

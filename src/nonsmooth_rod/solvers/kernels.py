@@ -1,0 +1,107 @@
+"""The one-step solvers as compiled kernels behind one interface (for the compiled loops).
+
+The step problem (dense): u = W p + q, m = 2 na unknowns ordered (N, T) per contact, with
+the friction interval [lo_i p_N, hi_i p_N] of `problem.PlanarFrictionProblem`::
+
+    solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter) -> (status, iterations, residual)
+
+fills p and u = W p + q in place (p is also pgs's warm start) and returns a status code,
+the solver's iterations (Lemke pivots, pgs sweeps, enum combinations) and the common
+complementarity residual. ``rtol`` is the tolerance on that residual relative to the
+problem's scale max(‖q‖∞, ‖p‖∞, ‖u‖∞); ``rtol ≤ 0`` takes the solver's default (Lemke and
+enum accept DEFAULT_RTOL; pgs aims for PGS_RTOL and accepts DEFAULT_RTOL once it stalls).
+``max_iter``: Lemke's pivot limit, pgs's sweep limit (≤ 0: their defaults); enum ignores it
+(all 4^na combinations up to enumeration.MAX_CONTACTS contacts, KERNEL_TOO_LARGE beyond).
+On any status but KERNEL_SOLVED, p = 0 and u = q (pgs leaves its last iterate).
+
+Large scenes: `pgs_block` on the block-sparse Delassus (indptr, indices, blocks; see
+`gauss_seidel.dense_to_blocks`) costs O(nonzero blocks) per sweep.
+
+Every function here is decorated with `nonsmooth_rod._jit.jit`: numba-compiled when numba is
+installed, the same source interpreted otherwise. Float64 arrays, int64 scalars only.
+Non-finite data return KERNEL_NONFINITE (p = 0, u = q) instead of garbage.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import jit
+from .enumeration import enum_interval
+from .gauss_seidel import dense_to_blocks, pgs_block, pgs_dense
+from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_kernel
+
+from .kernel_base import (
+    DEFAULT_RTOL,
+    KERNEL_NO_CONVERGENCE,
+    KERNEL_NONFINITE,
+    KERNEL_RAY,
+    KERNEL_SOLVED,
+    KERNEL_TOO_LARGE,
+    SOLVER_CODES,
+    SOLVER_ENUM,
+    SOLVER_LEMKE,
+    SOLVER_PGS,
+    STATUS_NAMES,
+    all_finite,
+    contact_residual,
+    problem_scale,
+    step_residual,
+)
+
+
+@jit
+def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots):
+    """Lemke on the interval LCP, then on the cone LCP if that fails (as lemke_friction does).
+
+    Returns (status, pivots, residual); the first formulation's failure status when both fail.
+    """
+    if rtol <= 0.0:
+        rtol = DEFAULT_RTOL
+    first_status = KERNEL_SOLVED
+    pivots = 0
+    residual = 0.0
+    for attempt in range(2):
+        formulation = INTERVAL if attempt == 0 else CONE
+        limit = max_pivots if max_pivots > 0 else default_max_pivots((3 + attempt) * lo.shape[0])
+        p_new, u_new, residual, status, pivots, norms = _lemke_friction_kernel(
+            W, q, lo, hi, limit, formulation)
+        scale = norms[2] if norms[2] > 0.0 else 1.0
+        if status == SOLVED and residual <= rtol * scale:
+            p[:] = p_new
+            u[:] = u_new
+            return KERNEL_SOLVED, pivots, residual
+        if attempt == 0:
+            first_status = KERNEL_RAY if status == RAY else KERNEL_NO_CONVERGENCE
+    p[:] = 0.0
+    u[:] = q
+    return first_status, pivots, residual
+
+
+@jit
+def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
+    """Solve the dense step problem with solver SOLVER_LEMKE | SOLVER_PGS | SOLVER_ENUM.
+
+    Fills p, u in place; returns (status, iterations, residual) (module docstring).
+    """
+    if not (all_finite(W) and all_finite(q) and all_finite(lo) and all_finite(hi)):
+        p[:] = 0.0
+        u[:] = q
+        return KERNEL_NONFINITE, 0, np.inf
+    if q.shape[0] == 0:
+        return KERNEL_SOLVED, 0, 0.0
+    if solver_code == SOLVER_LEMKE:
+        return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter)
+    if solver_code == SOLVER_PGS:
+        return pgs_dense(W, q, lo, hi, p, u, rtol, max_iter)
+    if solver_code == SOLVER_ENUM:
+        return enum_interval(W, q, lo, hi, p, u, rtol, 0)  # max_iter: no meaning for enum
+    p[:] = 0.0  # an unknown solver code: nothing solved
+    u[:] = q
+    return KERNEL_NO_CONVERGENCE, 0, np.inf
+
+
+__all__ = [
+    "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
+    "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
+    "solve_interval", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
+]

@@ -1,0 +1,74 @@
+"""The public generic LCP solver: nonsmooth_rod.solvers.lcp.lemke on textbook problems."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nonsmooth_rod.solvers import lcp
+from nonsmooth_rod.validation import InputError
+
+
+@pytest.mark.parametrize("M, q, z_exact", [
+    # symmetric positive definite: both unknowns active, M z = −q
+    ([[2.0, 1.0], [1.0, 2.0]], [-5.0, -6.0], [4.0 / 3.0, 7.0 / 3.0]),
+    # non-symmetric P-matrix (principal minors 1, 1, 2): z = (1, 2), w = 0
+    ([[1.0, -1.0], [1.0, 1.0]], [1.0, -3.0], [1.0, 2.0]),
+    # Murty's lower-triangular P-matrix: z = (8, 0, 0), w = (0, 4, 2)
+    ([[1.0, 0.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 1.0]], [-8.0, -12.0, -14.0], [8.0, 0.0, 0.0]),
+    # only the second unknown active: z2 = 3/4, w1 = 1 − 3/4·1
+    ([[3.0, 1.0], [1.0, 4.0]], [1.0, -3.0], [0.0, 0.75]),
+])
+def test_p_matrix_lcps_with_known_solution(M, q, z_exact):
+    result = lcp.lemke(M, q)
+    assert result.status == "solved" and result.success
+    np.testing.assert_allclose(result.z, z_exact, rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(result.w, np.array(M) @ z_exact + np.array(q), atol=1e-13)
+    assert result.w.min() >= -1e-14 and abs(result.z @ result.w) <= 1e-13
+
+
+def test_nonnegative_q_needs_no_pivot():
+    result = lcp.lemke(np.eye(3), [1.0, 0.0, 2.0])
+    assert result.success and result.pivots == 0 and np.all(result.z == 0.0)
+    np.testing.assert_array_equal(result.w, [1.0, 0.0, 2.0])
+
+
+@pytest.mark.parametrize("M, q", [
+    ([[-1.0]], [-1.0]),  # w = −z − 1 < 0 for all z ≥ 0
+    ([[-1.0, 1.0], [1.0, -1.0]], [-1.0, -1.0]),  # w1 + w2 = −2: infeasible
+])
+def test_infeasible_lcp_reports_a_secondary_ray(M, q):
+    result = lcp.lemke(M, q)
+    assert result.status == "ray" and not result.success
+
+
+def test_pivot_limit_is_reported():
+    M = [[1.0, 2.0, 0.0], [0.0, 1.0, 2.0], [2.0, 0.0, 1.0]]
+    result = lcp.lemke(M, -np.ones(3), max_pivots=1)
+    assert result.status == "pivot-limit" and result.pivots == 1
+    assert lcp.lemke(M, -np.ones(3)).success
+
+
+@pytest.mark.parametrize("M, q, name", [
+    ([[np.nan, 1.0], [1.0, 2.0]], [-1.0, -1.0], "M"),
+    ([[2.0, 1.0], [1.0, np.inf]], [-1.0, -1.0], "M"),
+    ([[2.0, 1.0], [1.0, 2.0]], [-np.inf, -1.0], "q"),
+    ([[2.0, 1.0], [1.0, 2.0]], [-1.0, np.nan], "q"),
+])
+def test_non_finite_data_refused_naming_the_argument(M, q, name):
+    with pytest.raises(InputError, match=rf"^lemke: {name} must be finite, got (nan|inf|-inf) at index"):
+        lcp.lemke(M, q)
+
+
+def test_malformed_input_refused():
+    with pytest.raises(InputError, match="M must be 2×2 for q of length 2"):
+        lcp.lemke(np.eye(3), [1.0, 2.0])
+    with pytest.raises(InputError, match="M must be an array of numbers"):
+        lcp.lemke("x", [1.0])
+    with pytest.raises(InputError, match="max_pivots must be a non-negative integer"):
+        lcp.lemke(np.eye(2), [1.0, 2.0], max_pivots=2.5)
+
+
+def test_reachable_from_the_package():
+    import nonsmooth_rod.solvers as solvers
+
+    assert solvers.lcp.lemke is lcp.lemke
