@@ -15,11 +15,10 @@ nonsmooth solutions and, with e = 0 and θ = ½, dissipative (energy never grows
 """
 from __future__ import annotations
 
-import importlib
 import math
-import sys
 import time
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
 from ..solvers import available_solvers
+from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
 from ..validation import InputError, require_in_range, require_positive
@@ -35,8 +35,9 @@ from . import moreau_jean_loop as loop
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 
 STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
-# Solver settings the compiled kernels take (the Python solvers read solver_options themselves).
-DEFAULT_RTOL, DEFAULT_MAX_ITER = 1e-9, 10_000
+# Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
+# 0 means the kernel's own default (solvers/kernels.py).
+DEFAULT_RTOL, DEFAULT_MAX_ITER = 0.0, 0
 
 
 @dataclass
@@ -70,34 +71,15 @@ class MoreauJeanOptions:
             raise InputError(f"min_phase must be non-negative, got {self.min_phase!r}")
 
 
-_INTERPRETED = {}
-_KERNEL_MODULES = ("nonsmooth_rod.model.forces", "nonsmooth_rod.model.packing",
-                   "nonsmooth_rod.solvers.two_coefficient", "nonsmooth_rod.integrators.moreau_jean_loop")
+_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
 
 
 def loop_kernels(compiled: bool):
-    """The loop module: compiled (as imported), or a plain-Python copy of the same source.
-
-    numba dispatchers compile when called, even from a `py_func`, so the interpreted loop is a
-    second import of the kernel modules made while `_jit.ENABLED` is off (cached; the package's
-    own modules are left as they were).
-    """
+    """The loop's entry points: compiled (the module itself), or their plain-Python twins from
+    the same source (solvers._common.interpreted rebinds every kernel they call)."""
     if compiled or not _jit.ENABLED:
         return loop
-    if "loop" not in _INTERPRETED:
-        saved = {name: sys.modules.pop(name) for name in _KERNEL_MODULES if name in sys.modules}
-        _jit.ENABLED = False
-        try:
-            _INTERPRETED["loop"] = importlib.import_module(loop.__name__)
-        finally:
-            _jit.ENABLED = True
-            for name in _KERNEL_MODULES:
-                sys.modules.pop(name, None)
-            sys.modules.update(saved)
-            for name, module in saved.items():  # the packages' attributes, too
-                parent, _, child = name.rpartition(".")
-                setattr(sys.modules[parent], child, module)
-    return _INTERPRETED["loop"]
+    return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
 
 
 def _allocate(packed, q0, v0, n_steps):

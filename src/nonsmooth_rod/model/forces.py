@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._jit import jit
+from ..solvers._common import interpreted
 from ..validation import InputError, require_finite, require_nonnegative
 
 # Force kinds of the packed table.
@@ -54,7 +55,7 @@ class _Force:
         if int(index[0, FI_BODY_A]) * 3 + 3 > n_dof or int(index[0, FI_BODY_B]) * 3 + 3 > n_dof:
             raise InputError(f"{self.name}: body index beyond the scene's {n_dof // 3} bodies")
         f = np.zeros(n_dof)
-        _interpreted(accumulate_forces)(float(t), np.asarray(q, dtype=float), np.asarray(v, dtype=float),
+        interpreted(accumulate_forces)(float(t), np.asarray(q, dtype=float), np.asarray(v, dtype=float),
                                         table, index, times, values, f)
         return f
 
@@ -201,11 +202,6 @@ def pack_forces(forces) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
                              f"TabulatedForce, got {type(force).__name__}")
     return (table, index, np.array(times, dtype=float).reshape(-1),
             np.array(values, dtype=float).reshape(-1, 3))
-
-
-def _interpreted(kernel):
-    """The plain-Python function behind a compiled kernel (the kernel itself without numba)."""
-    return getattr(kernel, "py_func", kernel)
 
 
 @jit

@@ -19,58 +19,19 @@ naive "μd if it slid last step" rule gets wrong. See docs/friction.md.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import solvers as _solvers
 from .._jit import jit
-from .lemke import CONE, INTERVAL, RAY, RESIDUAL_TOL, SOLVED, _lemke_friction_kernel
-from .problem import NoConvergence, PlanarFrictionProblem, RayTermination, SolverError
+# The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
+# Python (solve_two_coefficient below).
+from .kernels import KERNEL_SOLVED, SOLVER_CODES, solve_interval
+from ._common import interpreted
+from .problem import PlanarFrictionProblem, SolverError
 
-# --- the solver call point ---------------------------------------------------------------------
-# API.md's solvers.kernels.solve_interval. Until solvers/kernels.py lands, this local adapter
-# with the same signature and codes serves lemke; switching is replacing this block by
-#     from .kernels import (KERNEL_SOLVED, KERNEL_RAY, KERNEL_NO_CONVERGENCE, KERNEL_TOO_LARGE,
-#                           KERNEL_NONFINITE, SOLVER_LEMKE, SOLVER_PGS, SOLVER_ENUM, solve_interval)
-# and COMPILED_SOLVERS below by all three names.
-KERNEL_SOLVED, KERNEL_RAY, KERNEL_NO_CONVERGENCE, KERNEL_TOO_LARGE, KERNEL_NONFINITE = 0, 1, 2, 3, 4
-SOLVER_LEMKE, SOLVER_PGS, SOLVER_ENUM = 0, 1, 2
-
-
-@jit
-def _lemke_attempt(W, q, lo, hi, formulation, p, u):
-    """One formulation of solvers.lemke.lemke_friction: (status, pivots, residual) and p, u."""
-    na = lo.shape[0]
-    per_contact = 3 if formulation == INTERVAL else 4
-    pp, uu, residual, status, pivots, norms = _lemke_friction_kernel(
-        W, q, lo, hi, 50 + 20 * per_contact * na, formulation)  # lemke._default_max_pivots
-    for r in range(2 * na):
-        p[r] = pp[r]
-        u[r] = uu[r]
-    scale = norms[2] if norms[2] > 0.0 else 1.0
-    if status == SOLVED and not residual <= RESIDUAL_TOL * scale:
-        return KERNEL_NO_CONVERGENCE, pivots, residual
-    if status == SOLVED:
-        return KERNEL_SOLVED, pivots, residual
-    return (KERNEL_RAY if status == RAY else KERNEL_NO_CONVERGENCE), pivots, residual
-
-
-@jit
-def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
-    """API.md's dispatcher, lemke only: the interval LCP, then the cone LCP if that one fails."""
-    if solver_code != SOLVER_LEMKE:
-        return KERNEL_NO_CONVERGENCE, 0, math.inf
-    status, pivots, residual = _lemke_attempt(W, q, lo, hi, INTERVAL, p, u)
-    if status != KERNEL_SOLVED:
-        status, more, residual = _lemke_attempt(W, q, lo, hi, CONE, p, u)
-        pivots += more
-    return status, pivots, residual
-
-
-COMPILED_SOLVERS = {"lemke": SOLVER_LEMKE}
-# --- end of the solver call point --------------------------------------------------------------
+COMPILED_SOLVERS = SOLVER_CODES  # solver name -> code of the compiled kernels
 
 # Contact state codes (API.md): open, stick, slip+, slip−.
 STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
@@ -218,7 +179,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     mu_d = np.ascontiguousarray(mu_d, dtype=float)
     guess = np.array(slip_guess, dtype=float)
     na = guess.shape[0]
-    classify, action_of = _python(classify_solution), _python(next_action)
+    classify, action_of = interpreted(classify_solution), interpreted(next_action)
     lo, hi, new_guess, states = np.empty(na), np.empty(na), np.empty(na), np.zeros(na, dtype=np.int64)
     tried = np.empty((max_solves + 1, na))
     velocity_tol = 1e-9 * max(1e-12, float(np.max(np.abs(q), initial=0.0)))
@@ -226,7 +187,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     while True:
         tried[n_tried] = guess
         n_tried += 1
-        _python(_interval_of)(mu_s, mu_d, guess, lo, hi)
+        interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
         sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
         iterations += sol.iterations
         if classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess):
@@ -237,7 +198,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         if action == NEXT_RETRY:
             continue
         if action == NEXT_TRY_ZERO:
-            _python(_interval_of)(mu_s, mu_d, guess, lo, hi)
+            interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
             sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
             iterations += sol.iterations
             n_tried += 1
@@ -246,11 +207,6 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     return StepContactResult(np.asarray(sol.p, dtype=float), np.asarray(sol.u, dtype=float),
                              [STATE_NAMES[s] for s in states], guess.copy(), n_tried, iterations,
                              float(sol.residual), consistent)
-
-
-def _python(kernel):
-    """The plain-Python function behind a kernel (so Python callers never trigger a compile)."""
-    return getattr(kernel, "py_func", kernel)
 
 
 __all__ = ["solve_two_coefficient", "two_coefficient_kernel", "StepContactResult", "classify_solution",
