@@ -168,7 +168,7 @@ class MoreauJean:
         if na > 0:
             W, q_step = np.zeros((2 * na, 2 * na)), np.empty(2 * na)
             guess, mu_s, mu_d = np.empty(na), np.empty(na), np.empty(na)
-            kernels.assemble(params, na, v[k], model, work, W, q_step, guess, mu_s, mu_d)
+            kernels.assemble(params, na, q[k], v[k], model, work, W, q_step, guess, mu_s, mu_d)
             try:
                 res = solve_two_coefficient(W, q_step, mu_s, mu_d, guess, self.options.solver,
                                             self.options.solver_options)

@@ -31,6 +31,8 @@ from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MIN
 # Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
 # of a few ulps either side of zero, and must not be left out of the step for that.
 ACTIVATION_ROUNDOFF = 1e-12
+# A persistent contact's gap below this many ulps of the largest coordinate is round-off.
+GAP_ROUNDOFF_ULPS = 64.0
 # Multiple of h² |g̈| within which a closed contact's gap counts as closed (persistence_margin).
 PERSISTENCE_FACTOR = 4.0
 # A contact closes "with approaching velocity" when u_N before the step is below this.
@@ -102,11 +104,17 @@ def _block_product(row_i, index, i, row_j, j, minv):
 
 
 @jit
-def assemble(params, na, vk, model, work, W, q_step, guess, mu_s, mu_d):
+def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
     minv, weight, table, index, ftable, findex, ftimes, fvalues = model
     gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
     h = params[P_H]
+    # A gap of a few ulps of the positions is no gap: closing it would ask a velocity round-off/h
+    # that a body's other contacts cannot all follow (a statically indeterminate body would slip).
+    gap_roundoff = 1.0
+    for d in range(vk.shape[0]):
+        gap_roundoff = max(gap_roundoff, abs(qk[d]))
+    gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
     for a in range(na):
         i = active[a]
         for b in range(na):
@@ -123,7 +131,8 @@ def assemble(params, na, vk, model, work, W, q_step, guess, mu_s, mu_d):
             # turns with the body within the step, so a purely velocity-level law lets the gap
             # creep open by O(h) per unit time. u_N ≥ −g/h for g > 0 removes the creep; a
             # penetration (g < 0) is not pushed out, which would inject energy after impacts.
-            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + max(gaps[i], 0.0) / h
+            gap = gaps[i] if gaps[i] > gap_roundoff else 0.0
+            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + gap / h
             guess[a] = slip_sign[i]
         else:
             u_n = local_dot(hn[i], index, i, vk)
@@ -239,23 +248,24 @@ def _rides_the_gap(i, params, work, index, v_next):
 
 
 @jit
-def solve_step(params, iparams, na, vk, model, work, out):
+def solve_step(params, iparams, na, qk, vk, model, work, out):
     """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
     m = 2 * na
     W = np.zeros((m, m))
     q_step = np.empty(m)
     guess, mu_s, mu_d = np.empty(na), np.empty(na), np.empty(na)
-    assemble(params, na, vk, model, work, W, q_step, guess, mu_s, mu_d)
+    assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d)
+    start_guess = guess.copy()  # prefer_sticking asks which contacts started the step at rest
     p, u = np.zeros(m), np.zeros(m)
     states = np.zeros(na, dtype=np.int64)
     status, solves, iterations, consistent = two_coefficient_kernel(
         iparams[I_SOLVER], W, q_step, mu_s, mu_d, guess, params[P_RTOL], iparams[I_MAX_ITER], p, u, states)
-    # --- prefer_sticking call point (API.md; solvers/sticking.py, branch `step`) -------------
-    # Once the sign iteration is consistent, a colleague's prefer_sticking(W, q_step, mu_s, mu_d,
-    # guess, p, u, states) may overwrite p, u, states with a solution that keeps more contacts
-    # sticking. Wire it here:
-    #     if status == KERNEL_SOLVED and consistent:
-    #         prefer_sticking(W, q_step, mu_s, mu_d, guess, p, u, states)
+    # --- prefer_sticking call point (solvers/sticking.py, branch `step`) ---------------------
+    # Once the sign iteration is consistent, prefer_sticking may overwrite p, u, states with an
+    # admissible solution that holds more of the contacts that started the step at rest. Wire:
+    #     if status == KERNEL_SOLVED and consistent and _started_at_rest_and_moves(states, start_guess):
+    #         prefer_sticking(W, q_step, mu_s, mu_d, start_guess, velocity_tol, p, u, states)
+    # (velocity_tol = 1e-9 max(1e-12, max|q_step|), as two_coefficient_kernel's.)
     counters = out[9]
     counters[K_SOLVES] += solves
     counters[K_ITERATIONS] += iterations
@@ -275,7 +285,7 @@ def compiled_step(k, f, params, iparams, model, work, out):
         return RUN_BAD_GEOMETRY
     p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
     if na > 0:
-        status, p, u, states = solve_step(params, iparams, na, vk, model, work, out)
+        status, p, u, states = solve_step(params, iparams, na, qk, vk, model, work, out)
         if status != KERNEL_SOLVED:
             counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
