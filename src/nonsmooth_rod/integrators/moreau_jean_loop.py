@@ -25,6 +25,7 @@ from .._jit import jit
 from ..model.forces import accumulate_forces
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_BODY_B,
                              contact_kinematics, local_dot)
+from ..solvers.kernels import SOLVER_PGS
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
                                        two_coefficient_kernel)
 
@@ -104,6 +105,69 @@ def _block_product(row_i, index, i, row_j, j, minv):
 
 
 @jit
+def _fill_block(block, hn, ht, index, i, j, minv):
+    """The 2×2 block (N, T)ᵢ M⁻¹ (N, T)ⱼᵀ of the Delassus matrix."""
+    block[0, 0] = _block_product(hn[i], index, i, hn[j], j, minv)
+    block[0, 1] = _block_product(hn[i], index, i, ht[j], j, minv)
+    block[1, 0] = _block_product(ht[i], index, i, hn[j], j, minv)
+    block[1, 1] = _block_product(ht[i], index, i, ht[j], j, minv)
+
+
+@jit
+def _contacts_by_body(na, active, index, n_bodies):
+    """(start, members): the active contacts (positions in `active`) touching each body, CSR."""
+    start = np.zeros(n_bodies + 1, dtype=np.int64)
+    for a in range(na):
+        for side in range(2):
+            body = index[active[a], CI_BODY_A + side]
+            if body >= 0:
+                start[body + 1] += 1
+    for b in range(n_bodies):
+        start[b + 1] += start[b]
+    members = np.empty(start[n_bodies], dtype=np.int64)
+    fill = start.copy()
+    for a in range(na):
+        for side in range(2):
+            body = index[active[a], CI_BODY_A + side]
+            if body >= 0:
+                members[fill[body]] = a
+                fill[body] += 1
+    return start, members
+
+
+@jit
+def delassus_blocks(na, model, work):
+    """The block-sparse Delassus matrix over the active contacts (solvers.kernels' CSR layout:
+    indptr, indices, 2×2 blocks): a block for each pair of contacts sharing a body, so building
+    it costs O(active contacts × contacts per body), not O(contacts²)."""
+    minv, index = model[0], model[3]
+    hn, ht, active = work[2], work[3], work[4]
+    start, members = _contacts_by_body(na, active, index, minv.shape[0] // 3)
+    indptr = np.zeros(na + 1, dtype=np.int64)
+    seen = np.full(na, -1, dtype=np.int64)
+    for sweep in range(2):  # count, then fill
+        if sweep == 1:
+            indices = np.empty(indptr[na], dtype=np.int64)
+            blocks = np.empty((indptr[na], 2, 2))
+            seen[:] = -1
+        for a in range(na):
+            n = 0
+            for side in range(2):
+                body = index[active[a], CI_BODY_A + side]
+                for m in range(start[body] if body >= 0 else 0, start[body + 1] if body >= 0 else 0):
+                    b = members[m]
+                    if seen[b] != a:
+                        seen[b] = a
+                        if sweep == 1:
+                            indices[indptr[a] + n] = b
+                            _fill_block(blocks[indptr[a] + n], hn, ht, index, active[a], active[b], minv)
+                        n += 1
+            if sweep == 0:
+                indptr[a + 1] = indptr[a] + n
+    return indptr, indices, blocks
+
+
+@jit
 def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
     minv, weight, table, index, ftable, findex, ftimes, fvalues = model
@@ -117,12 +181,9 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
     gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
     for a in range(na):
         i = active[a]
-        for b in range(na):
+        for b in range(na if W.shape[0] > 0 else 0):  # dense W: for lemke and enum
             j = active[b]
-            W[2 * a, 2 * b] = _block_product(hn[i], index, i, hn[j], j, minv)
-            W[2 * a, 2 * b + 1] = _block_product(hn[i], index, i, ht[j], j, minv)
-            W[2 * a + 1, 2 * b] = _block_product(ht[i], index, i, hn[j], j, minv)
-            W[2 * a + 1, 2 * b + 1] = _block_product(ht[i], index, i, ht[j], j, minv)
+            _fill_block(W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2], hn, ht, index, i, j, minv)
         surface = table[i, C_SURFACE_VELOCITY]
         q_step[2 * a + 1] = local_dot(ht[i], index, i, v_free) - surface
         mu_s[a], mu_d[a] = table[i, C_MU_S], table[i, C_MU_D]
@@ -248,18 +309,37 @@ def _rides_the_gap(i, params, work, index, v_next):
 
 
 @jit
-def solve_step(params, iparams, na, qk, vk, model, work, out):
+def _warm_start(k, na, work, out, p):
+    """The previous step's impulses of the contacts that stay closed (pgs starts from p)."""
+    active, was_closed, p_normal, p_tangent = work[4], work[5], out[2], out[3]
+    if k == 0:
+        return
+    for a in range(na):
+        i = active[a]
+        if was_closed[i]:
+            p[2 * a], p[2 * a + 1] = p_normal[k - 1, i], p_tangent[k - 1, i]
+
+
+@jit
+def solve_step(k, params, iparams, na, qk, vk, model, work, out):
     """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
     m = 2 * na
-    W = np.zeros((m, m))
+    sparse = iparams[I_SOLVER] == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
+    W = np.zeros((0, 0)) if sparse else np.zeros((m, m))
     q_step = np.empty(m)
     guess, mu_s, mu_d = np.empty(na), np.empty(na), np.empty(na)
     assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d)
+    if sparse:
+        indptr, indices, blocks = delassus_blocks(na, model, work)
+    else:
+        indptr, indices, blocks = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2))
     start_guess = guess.copy()  # prefer_sticking asks which contacts started the step at rest
     p, u = np.zeros(m), np.zeros(m)
+    _warm_start(k, na, work, out, p)
     states = np.zeros(na, dtype=np.int64)
     status, solves, iterations, consistent = two_coefficient_kernel(
-        iparams[I_SOLVER], W, q_step, mu_s, mu_d, guess, params[P_RTOL], iparams[I_MAX_ITER], p, u, states)
+        iparams[I_SOLVER], W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, params[P_RTOL],
+        iparams[I_MAX_ITER], p, u, states)
     # --- prefer_sticking call point (solvers/sticking.py, branch `step`) ---------------------
     # Once the sign iteration is consistent, prefer_sticking may overwrite p, u, states with an
     # admissible solution that holds more of the contacts that started the step at rest. Wire:
@@ -285,7 +365,7 @@ def compiled_step(k, f, params, iparams, model, work, out):
         return RUN_BAD_GEOMETRY
     p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
     if na > 0:
-        status, p, u, states = solve_step(params, iparams, na, qk, vk, model, work, out)
+        status, p, u, states = solve_step(k, params, iparams, na, qk, vk, model, work, out)
         if status != KERNEL_SOLVED:
             counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED

@@ -27,7 +27,7 @@ from .. import solvers as _solvers
 from .._jit import jit
 # The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
 # Python (solve_two_coefficient below).
-from .kernels import KERNEL_SOLVED, SOLVER_CODES, solve_interval
+from .kernels import KERNEL_SOLVED, SOLVER_CODES, pgs_block, solve_interval
 from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
 
@@ -129,9 +129,20 @@ def _interval_of(mu_s, mu_d, guess, lo, hi):
 
 
 @jit
-def two_coefficient_kernel(solver_code, W, q, mu_s, mu_d, guess, rtol, max_iter, p, u, states):
+def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval on the dense W, or pgs_block when the block-sparse W is given (indptr)."""
+    if indptr.shape[0] > 0:
+        return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+    return solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+
+
+@jit
+def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, rtol, max_iter, p, u,
+                           states):
     """The exact two-coefficient law on u = W p + q, from slip guess `guess` (updated in place to
-    the converged guess). Returns (kernel status, solves, solver iterations, consistent)."""
+    the converged guess). W is dense (m × m), or empty with its block-sparse form (indptr,
+    indices, blocks: solvers.kernels' layout) for pgs. p holds the warm start (pgs).
+    Returns (kernel status, solves, solver iterations, consistent)."""
     na = guess.shape[0]
     lo, hi, new_guess = np.empty(na), np.empty(na), np.empty(na)
     tried = np.empty((MAX_SOLVES + 1, na))
@@ -144,7 +155,7 @@ def two_coefficient_kernel(solver_code, W, q, mu_s, mu_d, guess, rtol, max_iter,
         tried[n_tried] = guess
         n_tried += 1
         _interval_of(mu_s, mu_d, guess, lo, hi)
-        status, its, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+        status, its, residual = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
         iterations += its
         if status != KERNEL_SOLVED:
             return status, n_tried, iterations, False
@@ -157,7 +168,7 @@ def two_coefficient_kernel(solver_code, W, q, mu_s, mu_d, guess, rtol, max_iter,
             continue
         if action == NEXT_TRY_ZERO:
             _interval_of(mu_s, mu_d, guess, lo, hi)
-            status, its, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+            status, its, residual = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
             iterations += its
             n_tried += 1
             if status != KERNEL_SOLVED:
