@@ -86,10 +86,11 @@ def _allocate(packed, q0, v0, n_steps):
     """The model, work and out tuples of moreau_jean_loop."""
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
     model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
-             packed.force_index, packed.force_times, packed.force_values)
+             packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
+             packed.pair_keys, packed.pair_contact)
     work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
             np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-            np.zeros(n_dof))
+            np.zeros(n_dof), np.zeros(nc, dtype=np.int64))
     q = np.empty((n_steps + 1, n_dof))
     v = np.empty((n_steps + 1, n_dof))
     q[0], v[0] = q0, v0

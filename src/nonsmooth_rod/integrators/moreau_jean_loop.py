@@ -23,7 +23,8 @@ import numpy as np
 
 from .._jit import jit
 from ..model.forces import accumulate_forces
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_BODY_B,
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_BODY_B, CI_KIND,
+                             KIND_DISK_ON_DISK,
                              contact_kinematics, local_dot)
 from ..solvers.kernels import SOLVER_PGS
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
@@ -36,6 +37,8 @@ ACTIVATION_ROUNDOFF = 1e-12
 GAP_ROUNDOFF_ULPS = 64.0
 # Multiple of h² |g̈| within which a closed contact's gap counts as closed (persistence_margin).
 PERSISTENCE_FACTOR = 4.0
+# Added to every disk's reach in the broad phase (m): contacts placed exactly touching.
+BROAD_PHASE_SLACK = 1e-9
 # A contact closes "with approaching velocity" when u_N before the step is below this.
 IMPACT_VELOCITY_TOL = 1e-9
 # Run status codes.
@@ -64,17 +67,64 @@ def persistence_margin(h, drift, free_acceleration):
 
 
 @jit
+def _disk_reach(h, q, v, disks, disk_body, x, y, reach):
+    """World centres of the disks and how far each can reach this step (radius + h · speed)."""
+    for d in range(disks.shape[0]):
+        j = 3 * disk_body[d]
+        c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
+        ox, oy = disks[d, 0], disks[d, 1]
+        x[d] = q[j] + c * ox - s * oy
+        y[d] = q[j + 1] + s * ox + c * oy
+        speed = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1]) + abs(v[j + 2]) * math.sqrt(ox * ox + oy * oy)
+        reach[d] = disks[d, 2] + h * speed + BROAD_PHASE_SLACK
+
+
+@jit
+def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate):
+    """Mark the disk–disk contacts that can act this step: sort the disks along x, and test only
+    pairs whose centres are within their reach (sweep and prune), plus the contacts closed last
+    step. O(disks log disks + pairs in reach), whatever the number of listed contacts."""
+    n = disks.shape[0]
+    x, y, reach = np.empty(n), np.empty(n), np.empty(n)
+    _disk_reach(h, q, v, disks, disk_body, x, y, reach)
+    for i in range(candidate.shape[0]):
+        candidate[i] = was_closed[i]
+    order = np.argsort(x)
+    for a in range(n):
+        da = order[a]
+        for b in range(a + 1, n):
+            db = order[b]
+            if x[db] - x[da] > reach[da] + reach[db]:
+                break
+            if abs(y[db] - y[da]) > reach[da] + reach[db]:
+                continue
+            key = min(da, db) * n + max(da, db)
+            j = np.searchsorted(pair_keys, key)
+            while j < pair_keys.shape[0] and pair_keys[j] == key:
+                candidate[pair_contact[j]] = 1
+                j += 1
+
+
+@jit
 def begin_step(params, qk, vk, f, model, work):
     """Free velocity, contact kinematics and the active set; returns na (−1 − i: contact i has
     coincident disk centres)."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
+    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
     h, gamma = params[P_H], params[P_GAMMA]
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
         v_free[d] = vk[d] + h * a_free[d]
+    broad = pair_keys.shape[0] > 0
+    if broad:
+        broad_phase(h, qk, vk, disks, disk_body, pair_keys, pair_contact, was_closed, candidate)
     na = 0
     for i in range(table.shape[0]):
+        if broad and index[i, CI_KIND] == KIND_DISK_ON_DISK and not candidate[i]:
+            gaps[i], drifts[i] = math.inf, 0.0  # out of reach this step: no kinematics
+            hn[i, :] = 0.0
+            ht[i, :] = 0.0
+            continue
         gap, drift = contact_kinematics(table, index, i, qk, vk, hn[i], ht[i])
         if math.isnan(gap):
             return -1 - i
@@ -170,8 +220,8 @@ def delassus_blocks(na, model, work):
 @jit
 def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
+    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
     h = params[P_H]
     # A gap of a few ulps of the positions is no gap: closing it would ask a velocity round-off/h
     # that a body's other contacts cannot all follow (a statically indeterminate body would slip).
@@ -227,7 +277,7 @@ def crossing_offset(g, u, a, h):
 
 @jit
 def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
     index = model[3]
     impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
     h = params[P_H]
@@ -245,8 +295,8 @@ def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
 def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
     status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
+    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
     q, v, p_normal, p_tangent, slip, state_rec = out[0], out[1], out[2], out[3], out[4], out[5]
     h, theta = params[P_H], params[P_THETA]
     t = params[P_T0] + k * h
@@ -301,7 +351,7 @@ def _rides_the_gap(i, params, work, index, v_next):
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
     step is no impact — near a lift-off the normal force fades and such steps alternate with
     loaded ones."""
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free = work
+    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
     h = params[P_H]
     # within one step's worth of its acceleration, h² |g̈|: a hop of a ball at rest is longer
     margin = h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
@@ -375,7 +425,7 @@ def compiled_step(k, f, params, iparams, model, work, out):
 @jit
 def step_force(k, params, model, out, f):
     """f = weight + the packed forces at t_k + θh and (q_k, v_k)."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues = model
+    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
     q, v = out[0], out[1]
     f[:] = weight
     t = params[P_T0] + (k + params[P_THETA]) * params[P_H]

@@ -41,6 +41,10 @@ class PackedScene:
     force_index: np.ndarray
     force_times: np.ndarray
     force_values: np.ndarray
+    disks: np.ndarray  # (n_disks, 3): body-frame offset x, y and radius of every disk in a disk–disk contact
+    disk_body: np.ndarray  # (n_disks,) int64
+    pair_keys: np.ndarray  # (n_pairs,) int64 sorted: min(disk a, disk b) · n_disks + max(...)
+    pair_contact: np.ndarray  # (n_pairs,) int64: the contact of each key
 
     @property
     def n_contacts(self) -> int:
@@ -75,13 +79,37 @@ def pack_contacts(contacts, n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
     return table, index
 
 
+def pack_disk_pairs(table, index):
+    """The broad phase's tables: the distinct disks of the disk–disk contacts and, sorted by
+    disk pair, which contact joins them."""
+    disk_id, disks, bodies, keys, owners = {}, [], [], [], []
+    for i in np.flatnonzero(index[:, CI_KIND] == KIND_DISK_ON_DISK):
+        ends = []
+        for body, columns in ((index[i, CI_BODY_A], (C_OFF_AX, C_OFF_AY, C_RADIUS_A)),
+                              (index[i, CI_BODY_B], (C_OFF_BX, C_OFF_BY, C_RADIUS_B))):
+            disk = (int(body), *(float(table[i, c]) for c in columns))
+            if disk not in disk_id:
+                disk_id[disk] = len(disks)
+                disks.append(disk[1:])
+                bodies.append(disk[0])
+            ends.append(disk_id[disk])
+        keys.append(ends)
+        owners.append(i)
+    n = len(disks)
+    flat = np.array([min(a, b) * n + max(a, b) for a, b in keys], dtype=np.int64)
+    order = np.argsort(flat, kind="stable")
+    return (np.array(disks, dtype=float).reshape(-1, 3), np.array(bodies, dtype=np.int64), flat[order],
+            np.array(owners, dtype=np.int64)[order])
+
+
 def pack_scene(scene) -> PackedScene:
     table, index = pack_contacts(scene.contacts, len(scene.bodies))
     forces = pack_forces(getattr(scene, "forces", ()))
     if forces[1].size and int(forces[1][:, 1:3].max()) >= len(scene.bodies):
         raise InputError(f"forces: a body index is beyond the scene's {len(scene.bodies)} bodies")
     return PackedScene(np.ascontiguousarray(scene.inverse_mass_diagonal, dtype=float),
-                       np.ascontiguousarray(scene.weight, dtype=float), table, index, *forces)
+                       np.ascontiguousarray(scene.weight, dtype=float), table, index, *forces,
+                       *pack_disk_pairs(table, index))
 
 
 @jit
