@@ -324,8 +324,10 @@ def located_phases(scene, out, packed, impacts, n_done, h, min_phase, t_stop):
         bounds[-1] = max(float(t_stop), bounds[-2])
     impact_time = {(imp.contact, int(round(imp.t / h))): imp.t for imp in impacts}
     for i, name in enumerate(names):
-        modes = [STATE_NAMES[s] for s in out[5][:n_done, i]]
-        found = phases_from_intervals(bounds, modes, min_phase)
+        codes = out[5][:n_done, i]
+        starts = np.r_[0, np.flatnonzero(codes[1:] != codes[:-1]) + 1]  # runs of one state
+        found = phases_from_intervals(np.r_[bounds[starts], bounds[-1]], [STATE_NAMES[c] for c in codes[starts]],
+                                      min_phase)
         for before, after in zip(found, found[1:]):
             k = int(round(after.t_start / h))
             if before.mode == "open":
