@@ -68,3 +68,24 @@ def test_two_balls_on_a_floor_with_a_spring_and_a_disk_contact():
     fast, slow = _both(scene, q0, v0, 0.5, h=1e-3)
     assert [i.contact for i in fast.impacts][:2] == ["a-b", "b-floor"]  # every contact kind acts
     _assert_same(fast, slow)
+
+
+@pytest.mark.parametrize("toy", ["BouncingBall", "BlockOnIncline", "PushedBlock", "DiskOnIncline", "BeltOscillator",
+                                 "RockingBlock", "PainleveRod", "BallRow"])
+def test_every_toy_runs_compiled(toy):
+    from nonsmooth_rod import toys
+
+    run = toys.run(getattr(toys, toy)(), "moreau-jean", 0.02)
+    assert run.status == "ok" and run.stats["compiled"]
+    assert run.stats["force_callback"] == (toy in ("PushedBlock", "BeltOscillator"))  # Python callables
+
+
+@pytest.mark.parametrize("solver", ["lemke", "pgs", "enum", "osqp"])
+def test_the_rod_runs_compiled_with_every_exact_solver_and_python_with_qp(solver):
+    from nonsmooth_rod.solvers import available_solvers
+
+    if solver not in available_solvers():
+        pytest.skip(f"{solver} not installed")
+    p = RodProblem.paper(2)
+    run = MoreauJean(MoreauJeanOptions(h=1e-3, solver=solver)).run(p.scene(), *p.initial_state(), 0.05)
+    assert run.status == "ok" and run.stats["compiled"] == (solver != "osqp")
