@@ -21,9 +21,20 @@ import math
 
 import numpy as np
 
+from .. import _jit
 from .._jit import jit
+
+
+def _inlined(function):
+    """jit, inlined into its callers at numba's IR level: the per-step kernels pass the packed
+    tuples (~30 arrays), and a call boundary costs ~300 ns of reference counting for them."""
+    if not _jit.ENABLED:
+        return function
+    import numba
+
+    return numba.njit(cache=True, inline="always")(function)
 from ..model.forces import accumulate_forces
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_BODY_B, CI_KIND,
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
                              KIND_DISK_ON_DISK,
                              contact_kinematics, local_dot)
 from ..solvers.kernels import SOLVER_PGS
@@ -105,19 +116,20 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
                 j += 1
 
 
-@jit
+@_inlined
 def begin_step(params, qk, vk, f, model, work):
     """Free velocity, contact kinematics and the active set; returns na (−1 − i: contact i has
     coincident disk centres)."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
+    minv, table, index = model[0], model[2], model[3]  # only what is used: each array costs refcounting
+    gaps, drifts, hn, ht, active, was_closed = work[0], work[1], work[2], work[3], work[4], work[5]
+    v_free, a_free, candidate = work[8], work[9], work[10]
     h, gamma = params[P_H], params[P_GAMMA]
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
         v_free[d] = vk[d] + h * a_free[d]
-    broad = pair_keys.shape[0] > 0
+    broad = model[10].shape[0] > 0  # disk pairs to sort
     if broad:
-        broad_phase(h, qk, vk, disks, disk_body, pair_keys, pair_contact, was_closed, candidate)
+        broad_phase(h, qk, vk, model[8], model[9], model[10], model[11], was_closed, candidate)
     na = 0
     for i in range(table.shape[0]):
         if broad and index[i, CI_KIND] == KIND_DISK_ON_DISK and not candidate[i]:
@@ -217,11 +229,11 @@ def delassus_blocks(na, model, work):
     return indptr, indices, blocks
 
 
-@jit
+@_inlined
 def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
+    minv, table, index = model[0], model[2], model[3]
+    gaps, hn, ht, active, was_closed, slip_sign, v_free = work[0], work[2], work[3], work[4], work[5], work[7], work[8]
     h = params[P_H]
     # A gap of a few ulps of the positions is no gap: closing it would ask a velocity round-off/h
     # that a body's other contacts cannot all follow (a statically indeterminate body would slip).
@@ -277,7 +289,7 @@ def crossing_offset(g, u, a, h):
 
 @jit
 def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
+    gaps, drifts, hn, a_free = work[0], work[1], work[2], work[9]
     index = model[3]
     impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
     h = params[P_H]
@@ -291,12 +303,12 @@ def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
     return i == iparams[I_STOP]
 
 
-@jit
+@_inlined
 def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
     status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
+    minv, table, index = model[0], model[2], model[3]
+    hn, ht, active, was_closed, grazing, slip_sign, v_free = work[2], work[3], work[4], work[5], work[6], work[7], work[8]
     q, v, p_normal, p_tangent, slip, state_rec = out[0], out[1], out[2], out[3], out[4], out[5]
     h, theta = params[P_H], params[P_THETA]
     t = params[P_T0] + k * h
@@ -351,14 +363,14 @@ def _rides_the_gap(i, params, work, index, v_next):
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
     step is no impact — near a lift-off the normal force fades and such steps alternate with
     loaded ones."""
-    gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate = work
+    gaps, drifts, hn, a_free = work[0], work[1], work[2], work[9]
     h = params[P_H]
     # within one step's worth of its acceleration, h² |g̈|: a hop of a ball at rest is longer
     margin = h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
     return gaps[i] + h * local_dot(hn[i], index, i, v_next) <= margin
 
 
-@jit
+@_inlined
 def _warm_start(k, na, work, out, p):
     """The previous step's impulses of the contacts that stay closed (pgs starts from p)."""
     active, was_closed, p_normal, p_tangent = work[4], work[5], out[2], out[3]
@@ -370,7 +382,7 @@ def _warm_start(k, na, work, out, p):
             p[2 * a], p[2 * a + 1] = p_normal[k - 1, i], p_tangent[k - 1, i]
 
 
-@jit
+@_inlined
 def solve_step(k, params, iparams, na, qk, vk, model, work, out):
     """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
     m = 2 * na
@@ -383,7 +395,6 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
         indptr, indices, blocks = delassus_blocks(na, model, work)
     else:
         indptr, indices, blocks = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2))
-    start_guess = guess.copy()  # prefer_sticking asks which contacts started the step at rest
     p, u = np.zeros(m), np.zeros(m)
     _warm_start(k, na, work, out, p)
     states = np.zeros(na, dtype=np.int64)
@@ -392,7 +403,8 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
         iparams[I_MAX_ITER], p, u, states)
     # --- prefer_sticking call point (solvers/sticking.py, branch `step`) ---------------------
     # Once the sign iteration is consistent, prefer_sticking may overwrite p, u, states with an
-    # admissible solution that holds more of the contacts that started the step at rest. Wire:
+    # admissible solution that holds more of the contacts that started the step at rest. Wire
+    # (with start_guess = guess.copy() taken before the kernel, which updates guess in place):
     #     if status == KERNEL_SOLVED and consistent and _started_at_rest_and_moves(states, start_guess):
     #         prefer_sticking(W, q_step, mu_s, mu_d, start_guess, velocity_tol, p, u, states)
     # (velocity_tol = 1e-9 max(1e-12, max|q_step|), as two_coefficient_kernel's.)
@@ -404,7 +416,7 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
     return status, p, u, states
 
 
-@jit
+@_inlined
 def compiled_step(k, f, params, iparams, model, work, out):
     """One whole step with generalised force f; returns a run status."""
     q, v, counters = out[0], out[1], out[9]
@@ -422,17 +434,18 @@ def compiled_step(k, f, params, iparams, model, work, out):
     return finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out)
 
 
-@jit
+@_inlined
 def step_force(k, params, model, out, f):
     """f = weight + the packed forces at t_k + θh and (q_k, v_k)."""
-    minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys, pair_contact = model
+    weight, ftable = model[1], model[4]
     q, v = out[0], out[1]
     f[:] = weight
     t = params[P_T0] + (k + params[P_THETA]) * params[P_H]
-    accumulate_forces(t, q[k], v[k], ftable, findex, ftimes, fvalues, f)
+    if ftable.shape[0] > 0:
+        accumulate_forces(t, q[k], v[k], ftable, model[5], model[6], model[7], f)
 
 
-@jit
+@_inlined
 def end_of_step(k, status, counters):
     """Book step k's outcome in the counters (steps done; how and where the run ended)."""
     if status == RUN_OK or status == RUN_STOPPED:
