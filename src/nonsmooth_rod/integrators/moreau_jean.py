@@ -25,7 +25,7 @@ import numpy as np
 from .. import _jit
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
-from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
+from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..solvers import available_solvers
 from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
