@@ -168,8 +168,8 @@ class MoreauJean:
         p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
         if na > 0:
             W, q_step = np.zeros((2 * na, 2 * na)), np.empty(2 * na)
-            guess, mu_s, mu_d = np.empty(na), np.empty(na), np.empty(na)
-            kernels.assemble(params, na, q[k], v[k], model, work, W, q_step, guess, mu_s, mu_d)
+            guess, mu_s, mu_d, closing = np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+            kernels.assemble(params, na, q[k], v[k], model, work, W, q_step, guess, mu_s, mu_d, closing)
             try:
                 res = solve_two_coefficient(W, q_step, mu_s, mu_d, guess, self.options.solver,
                                             self.options.solver_options)

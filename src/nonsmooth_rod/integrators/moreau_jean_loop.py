@@ -230,7 +230,7 @@ def delassus_blocks(na, model, work):
 
 
 @_inlined
-def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
+def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
     minv, table, index = model[0], model[2], model[3]
     gaps, hn, ht, active, was_closed, slip_sign, v_free = work[0], work[2], work[3], work[4], work[5], work[7], work[8]
@@ -254,10 +254,11 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d):
             # turns with the body within the step, so a purely velocity-level law lets the gap
             # creep open by O(h) per unit time. u_N ≥ −g/h for g > 0 removes the creep; a
             # penetration (g < 0) is not pushed out, which would inject energy after impacts.
-            gap = gaps[i] if gaps[i] > gap_roundoff else 0.0
-            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + gap / h
+            closing[a] = (gaps[i] if gaps[i] > gap_roundoff else 0.0) / h  # the part asking to close a gap
+            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + closing[a]
             guess[a] = slip_sign[i]
         else:
+            closing[a] = 0.0
             u_n = local_dot(hn[i], index, i, vk)
             q_step[2 * a] = local_dot(hn[i], index, i, v_free) + table[i, C_RESTITUTION] * min(u_n, 0.0)
             u_t = local_dot(ht[i], index, i, vk) - surface  # a closing contact slides the way it arrives
@@ -389,8 +390,8 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
     sparse = iparams[I_SOLVER] == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
     W = np.zeros((0, 0)) if sparse else np.zeros((m, m))
     q_step = np.empty(m)
-    guess, mu_s, mu_d = np.empty(na), np.empty(na), np.empty(na)
-    assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d)
+    guess, mu_s, mu_d, closing = np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+    assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing)
     if sparse:
         indptr, indices, blocks = delassus_blocks(na, model, work)
     else:
@@ -405,9 +406,11 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
     # Once the sign iteration is consistent, prefer_sticking may overwrite p, u, states with an
     # admissible solution that holds more of the contacts that started the step at rest. Wire
     # (with start_guess = guess.copy() taken before the kernel, which updates guess in place):
-    #     if status == KERNEL_SOLVED and consistent and _started_at_rest_and_moves(states, start_guess):
-    #         prefer_sticking(W, q_step, mu_s, mu_d, start_guess, velocity_tol, p, u, states)
-    # (velocity_tol = 1e-9 max(1e-12, max|q_step|), as two_coefficient_kernel's.)
+    #     if status == KERNEL_SOLVED and consistent and W.shape[0] > 0 and <a contact with
+    #             start_guess 0 does not stick>:
+    #         prefer_sticking(W, q_step, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states)
+    # (velocity_tol = 1e-9 max(1e-12, max|q_step|), as two_coefficient_kernel's; W is empty for
+    # pgs, which has the block-sparse form: densify it for small na, or skip.)
     counters = out[9]
     counters[K_SOLVES] += solves
     counters[K_ITERATIONS] += iterations

@@ -202,7 +202,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
         iterations += sol.iterations
         if classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess):
-            consistent = True
+            consistent = True  # prefer_sticking call point (Python solvers): as in moreau_jean_loop.solve_step
             break
         action = action_of(new_guess, tried, n_tried)
         guess[:] = new_guess
