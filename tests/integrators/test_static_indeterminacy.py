@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from nonsmooth_rod.integrators import fast_moreau_jean
+from nonsmooth_rod import _jit
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.toys import BlockOnIncline, DiskPyramid, Ladder, WedgedRod
@@ -62,7 +62,7 @@ def test_ladder_just_below_its_critical_angle_slides_from_release(mu1, mu2, rati
     np.testing.assert_allclose(angular_acceleration[0], ladder.release_acceleration(), rtol=1e-9)
 
 
-@pytest.mark.skipif(not fast_moreau_jean.eligible(Ladder().scene(), "lemke"), reason="no compiled loop")
+@pytest.mark.skipif(not _jit.ENABLED, reason="numba not installed: no compiled loop")
 @pytest.mark.parametrize("mu1, mu2, ratio", LADDER_FRICTION)
 def test_compiled_loop_holds_the_ladder_for_1e5_steps(mu1, mu2, ratio):
     res = _run(_ladder(mu1, mu2, ratio, +0.2), "lemke", 1e-4, 100_000, fast=True)
@@ -170,7 +170,7 @@ def test_quick_drift_benchmark_runs_and_every_toy_holds(capsys):
     assert capsys.readouterr().out.count("True") == 16  # 4 toys x 4 solver runs, all stuck
 
 
-@pytest.mark.skipif(not fast_moreau_jean.eligible(WedgedRod().scene(), "lemke"), reason="no compiled loop")
+@pytest.mark.skipif(not _jit.ENABLED, reason="numba not installed: no compiled loop")
 def test_compiled_loop_holds_the_wedged_rod_for_1e5_steps():
     # near its locking angle the squeeze is large, the held velocity's round-off (~4e-16 m/s)
     # drifts the rod by ~1e-14 m, and the gap this opens must not make the step let go

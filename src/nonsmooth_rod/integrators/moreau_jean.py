@@ -5,7 +5,7 @@ Per step of size h, from (q_k, v_k):
     v_free  = v_k + h M⁻¹ f(t_k + θh, q_k, v_k)
     active  = contacts whose predicted gap g + γ h u_N closes (γ = ½ by default)
     u       = W p + q_step,  W = H M⁻¹ Hᵀ,  q_step = (H v_free + e u_N^k for the normal rows)
-    p       from the exact two-coefficient law (onestep.solve_two_coefficient, any solver)
+    p       from the exact two-coefficient law (solvers.two_coefficient)
     v_{k+1} = v_free + M⁻¹ Hᵀ p
     q_{k+1} = q_k + h ((1 − θ) v_k + θ v_{k+1})
 
@@ -18,25 +18,26 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
+from .. import _jit
+from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
-from . import fast_moreau_jean
-from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..solvers import available_solvers
+from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
+from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
 from ..validation import InputError, require_in_range, require_positive
+from . import moreau_jean_loop as loop
+from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 
-# Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
-# of a few ulps either side of zero, and must not be left out of the step for that.
-ACTIVATION_ROUNDOFF = 1e-12
-# A gap below this many ulps of the largest coordinate is round-off: not closed (_gap_to_close).
-GAP_ROUNDOFF_ULPS = 64.0
-GAP_ROUNDOFF = GAP_ROUNDOFF_ULPS * float(np.finfo(float).eps)
-STATE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
-STATE_NAMES = ("open", "stick", "slip+", "slip-")
+STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
+# Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
+# 0 means the kernel's own default (solvers/kernels.py).
+DEFAULT_RTOL, DEFAULT_MAX_ITER = 0.0, 0
 
 
 @dataclass
@@ -70,8 +71,39 @@ class MoreauJeanOptions:
             raise InputError(f"min_phase must be non-negative, got {self.min_phase!r}")
 
 
+_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
+
+
+def loop_kernels(compiled: bool):
+    """The loop's entry points: compiled (the module itself), or their plain-Python twins from
+    the same source (solvers._common.interpreted rebinds every kernel they call)."""
+    if compiled or not _jit.ENABLED:
+        return loop
+    return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
+
+
+def _allocate(packed, q0, v0, n_steps):
+    """The model, work and out tuples of moreau_jean_loop."""
+    n_dof, nc = packed.minv.shape[0], packed.n_contacts
+    model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
+             packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
+             packed.pair_keys, packed.pair_contact)
+    work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
+            np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
+            np.zeros(n_dof), np.zeros(nc, dtype=np.int64))
+    q = np.empty((n_steps + 1, n_dof))
+    v = np.empty((n_steps + 1, n_dof))
+    q[0], v[0] = q0, v0
+    per_step = [np.zeros((n_steps, nc)) for _ in range(3)]
+    capacity = n_steps + 4 * nc
+    out = (q, v, *per_step, np.zeros((n_steps, nc), dtype=np.int64), np.zeros(capacity),
+           np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
+           np.zeros(loop.N_COUNTERS, dtype=np.int64))
+    return model, work, out
+
+
 class MoreauJean:
-    """The Moreau–Jean one-step integrator over a Scene."""
+    """The Moreau–Jean one-step integrator over a Scene (one loop: moreau_jean_loop)."""
 
     name = "moreau-jean"
 
@@ -81,225 +113,240 @@ class MoreauJean:
     def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
         require_positive("t_end", t_end)
         opts = self.options
-        h, th = opts.h, opts.theta
-        n_steps = max(1, int(math.ceil(t_end / h - 1e-9)))
-        n_dof, nc = scene.n_dof, len(scene.contacts)
+        n_steps = max(1, int(math.ceil(t_end / opts.h - 1e-9)))
         names = [c.name for c in scene.contacts]
-        minv = scene.inverse_mass_diagonal
-        mu_s = np.array([c.law.friction.mu_s for c in scene.contacts])
-        mu_d = np.array([c.law.friction.mu_d for c in scene.contacts])
-        rest = np.array([c.law.impact.restitution for c in scene.contacts])
-        stop_index = names.index(opts.stop_at_impact) if opts.stop_at_impact in names else None
-        if opts.fast and fast_moreau_jean.eligible(scene, opts.solver):
-            return self._run_compiled(scene, q0, v0, n_steps, stop_index, names, t_end)
-
-        q = np.empty((n_steps + 1, n_dof))
-        v = np.empty((n_steps + 1, n_dof))
-        pN = np.zeros((n_steps, nc))
-        pT = np.zeros((n_steps, nc))
-        states = np.zeros((n_steps, nc), dtype=np.int8)
-        q[0], v[0] = q0, v0
-        slip_sign = np.zeros(nc)
-        was_closed = np.zeros(nc, dtype=bool)
-        events: list[Event] = []
-        impacts: list[Impact] = []
-        status, message = "ok", f"reached t_end = {t_end:g} s"
-        solves = iterations = inconsistent = 0
-        t_stop = None
+        q0, v0 = _state("q0", q0, scene.n_dof), _state("v0", v0, scene.n_dof)
+        packed = pack_scene(scene)
+        model, work, out = _allocate(packed, q0, v0, n_steps)
+        solver_code = COMPILED_SOLVERS.get(opts.solver)
+        solver_options = dict(opts.solver_options)
+        params = np.array([opts.h, opts.theta, opts.activation_gamma, 0.0,
+                           float(solver_options.get("tol", DEFAULT_RTOL))])
+        iparams = np.array([-1 if solver_code is None else solver_code,
+                            int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
+                            names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1],
+                           dtype=np.int64)
+        compiled = bool(opts.fast and _jit.ENABLED)
+        kernels = loop_kernels(compiled)
+        callback = scene.applied_force is not None
+        self._solver_error = None
         wall = time.process_time()
-        k = 0
+        if not callback and solver_code is not None:
+            kernels.run_steps(0, n_steps, params, iparams, model, work, out)
+        else:
+            self._run_stepwise(kernels, scene, n_steps, params, iparams, model, work, out)
+        cpu = time.process_time() - wall
+        stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
+                 "compiled": compiled and solver_code is not None, "force_callback": callback}
+        return self._result(scene, packed, out, names, t_end, cpu, stats)
+
+    def _run_stepwise(self, kernels, scene, n_steps, params, iparams, model, work, out):
+        """The loop step by step from Python: for a Python `applied_force` (called back for each
+        step's force) and for the Python (QP) solvers."""
+        q, v, counters = out[0], out[1], out[9]
+        h, th = params[loop.P_H], params[loop.P_THETA]
+        f = np.empty(scene.n_dof)
         for k in range(n_steps):
-            t = k * h
-            qk, vk = q[k], v[k]
-            kin = scene.kinematics(qk, vk)
-            f = scene.force(t + th * h, qk, vk)
-            v_free = vk + h * minv * f
-            # A contact enters the step when its predicted gap closes. A contact that acted in
-            # the previous step stays while its predicted gap is within the gap change one step
-            # of its own acceleration can cause (h² |g̈|): the velocity-level law lets a resting
-            # contact's gap wander by that much, and dropping it for one step would insert a
-            # spurious free-flight step (and a wrong slip guess) into a rolling phase.
-            active = []
-            for i, c in enumerate(kin):
-                predicted = c.gap + opts.activation_gamma * h * float(c.H_N @ vk)
-                margin = ACTIVATION_ROUNDOFF
-                if was_closed[i]:
-                    margin = max(margin, h * h * (abs(c.drift_N) + abs(float(c.H_N @ (minv * f)))))
-                if predicted <= margin:
-                    active.append(i)
-            if active:
-                position_scale = max(1.0, max(map(abs, qk.tolist())))  # plain floats: per step
-                H = np.empty((2 * len(active), n_dof))
-                q_step = np.empty(2 * len(active))
-                guess = np.empty(len(active))
-                closing = np.zeros(len(active))
-                for j, i in enumerate(active):
-                    c = kin[i]
-                    H[2 * j], H[2 * j + 1] = c.H_N, c.H_T
-                    if was_closed[i]:
-                        # A persistent contact may close an open gap, not only keep u_N ≥ 0:
-                        # the Jacobian turns with the body within the step, so a purely
-                        # velocity-level law lets the gap creep open by O(h) per unit time (then
-                        # the contact drops out and re-impacts). Asking u_N ≥ −g/h for g > 0
-                        # removes the creep; a penetration (g < 0) is not pushed out, which
-                        # would inject energy after every impact.
-                        closing[j] = _gap_to_close(c.gap, position_scale) / h
-                        q_step[2 * j] = float(c.H_N @ v_free) + closing[j]
-                    else:
-                        u_N_k = float(c.H_N @ vk)
-                        q_step[2 * j] = float(c.H_N @ v_free) + rest[i] * min(u_N_k, 0.0)
-                    q_step[2 * j + 1] = float(c.H_T @ v_free) - c.surface_velocity
-                    if was_closed[i]:
-                        guess[j] = slip_sign[i]
-                    else:  # a contact that closes now slides the way it arrives
-                        u_T_k = float(c.H_T @ vk) - c.surface_velocity
-                        guess[j] = 0.0 if abs(u_T_k) < 1e-12 else math.copysign(1.0, u_T_k)
-                W = H @ (minv[:, None] * H.T)
-                a_idx = np.array(active)
-                try:
-                    res = solve_two_coefficient(W, q_step, mu_s[a_idx], mu_d[a_idx], guess,
-                                                opts.solver, opts.solver_options, closing=closing)
-                except SolverError as err:
-                    state_txt = ", ".join(f"{names[i]}:{STATE_NAMES[states[k - 1, i]] if k else 'initial'}"
-                                          for i in range(nc))
-                    status = "failed"
-                    message = str(err.with_context(
-                        f"step {k}, t = {t:.9g} s, contact states {state_txt}, q = {np.array2string(qk, precision=6)}"))
-                    events.append(Event(t, "solver-failure", "", {"message": message}))
-                    break
-                solves += res.solves
-                iterations += res.iterations
-                inconsistent += not res.consistent
-                v_next = v_free + minv * (H.T @ res.p)
-                for j, i in enumerate(active):
-                    pN[k, i], pT[k, i] = res.p[2 * j], res.p[2 * j + 1]
-                    states[k, i] = STATE_CODES[res.states[j]]
-                    slip_sign[i] = {"slip+": 1.0, "slip-": -1.0}.get(res.states[j], 0.0)
+            kernels.step_force(k, params, model, out, f)
+            if scene.applied_force is not None:
+                f += np.asarray(scene.applied_force((k + th) * h, q[k], v[k]), dtype=float)
+            if iparams[loop.I_SOLVER] >= 0:
+                status = kernels.compiled_step(k, f, params, iparams, model, work, out)
             else:
-                v_next = v_free
-            closed_now = pN[k] > 0.0
-            v[k + 1] = v_next
-            q[k + 1] = qk + h * ((1.0 - th) * vk + th * v_next)
-            new_impacts = np.nonzero(closed_now & ~was_closed)[0]
-            for i in new_impacts:
-                u_before = float(kin[i].H_N @ vk)
-                if u_before < -1e-9:  # a closing contact, not a resting one re-entering
-                    t_hit = self._crossing_time(scene, kin[i], f, vk, t, h)
-                    v_hit = vk + (t_hit - t) * minv * f
-                    q_hit = qk + (t_hit - t) * vk
-                    impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v_next.copy(),
-                                          pN[k].copy(), pT[k].copy()))
-                    events.append(Event(t_hit, "impact", names[i], {"step": k}))
-                    if stop_index == i and t_stop is None:
-                        t_stop = t_hit
-            was_closed = closed_now
-            if not (np.all(np.isfinite(v[k + 1])) and np.all(np.isfinite(q[k + 1]))):
-                status, message = "failed", f"non-finite state at step {k + 1}, t = {(k + 1) * h:.9g} s"
+                status = self._python_solver_step(kernels, k, f, params, iparams, model, work, out)
+            if kernels.end_of_step(k, status, counters) != loop.RUN_OK:
                 break
-            if t_stop is not None:
-                status, message = "ok", f"stopped at the impact of {opts.stop_at_impact}"
-                break
-        n_done = k + 1 if status == "ok" else k
-        cpu = time.process_time() - wall
-        return self._result(scene, q, v, pN, pT, states, n_done, h, names, events, impacts,
-                            status, message, cpu, t_stop,
-                            {"solves": solves, "solver_iterations": iterations,
-                             "inconsistent_steps": inconsistent, "h": h, "theta": th,
-                             "solver": opts.solver, "compiled": False})
 
-    @staticmethod
-    def _crossing_time(scene, kin, f, vk, t, h) -> float:
-        """When the contact's gap crossed zero: the root of g + u τ + ½ a τ² nearest the step.
+    def _python_solver_step(self, kernels, k, f, params, iparams, model, work, out):
+        """One step with a Python solver (QP backends): the loop's kernels around
+        solve_two_coefficient."""
+        q, v, counters = out[0], out[1], out[9]
+        na = kernels.begin_step(params, q[k], v[k], f, model, work)
+        if na < 0:
+            counters[loop.K_FAIL_CONTACT] = -1 - na
+            return loop.RUN_BAD_GEOMETRY
+        p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
+        if na > 0:
+            W, q_step = np.zeros((2 * na, 2 * na)), np.empty(2 * na)
+            guess, mu_s, mu_d, closing = np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+            kernels.assemble(params, na, q[k], v[k], model, work, W, q_step, guess, mu_s, mu_d, closing)
+            try:
+                res = solve_two_coefficient(W, q_step, mu_s, mu_d, guess, self.options.solver,
+                                            self.options.solver_options, closing=closing)
+            except SolverError as err:
+                self._solver_error = err
+                return loop.RUN_SOLVER_FAILED
+            counters[loop.K_SOLVES] += res.solves
+            counters[loop.K_ITERATIONS] += res.iterations
+            counters[loop.K_INCONSISTENT] += not res.consistent
+            p, u = res.p, res.u
+            states = np.array([STATE_CODES[s] for s in res.states], dtype=np.int64)
+        return kernels.finish_step(k, params, iparams, na, p, u, states, q[k], v[k], model, work, out)
 
-        The contact may enter the problem a little before (predicted gap) or after (closing in
-        the second half of the previous step) the geometric crossing, so τ ∈ [−h, 2h].
-        """
-        g = kin.gap
-        u = float(kin.H_N @ vk)
-        a = float(kin.H_N @ (scene.inverse_mass_diagonal * f)) + kin.drift_N
-        roots = []
-        if abs(a) > 1e-14:
-            disc = u * u - 2.0 * a * g
-            if disc >= 0.0:
-                sq = math.sqrt(disc)
-                roots = [(-u - sq) / a, (-u + sq) / a]
-        elif u != 0.0:
-            roots = [-g / u]
-        roots = [r for r in roots if -h <= r <= 2 * h]
-        if not roots:
-            return t
-        return t + min(roots, key=abs)
+    def _ending(self, out, names, t_end):
+        """(status word, message, steps done, solver-failure event or None) from the counters."""
+        q, states, counters = out[0], out[5], out[9]
+        h, code, k = self.options.h, int(counters[loop.K_STATUS]), int(counters[loop.K_FAIL_STEP])
+        n_done = int(counters[loop.K_DONE]) if code != loop.RUN_OK else q.shape[0] - 1
+        if code == loop.RUN_OK:
+            return "ok", f"reached t_end = {t_end:g} s", n_done, None
+        if code == loop.RUN_STOPPED:
+            return "ok", f"stopped at the impact of {self.options.stop_at_impact}", n_done, None
+        if code == loop.RUN_NONFINITE:
+            return "failed", f"non-finite state at step {k + 1}, t = {(k + 1) * h:.9g} s", n_done, None
+        if code == loop.RUN_BAD_GEOMETRY:
+            name = names[int(counters[loop.K_FAIL_CONTACT])]
+            return "failed", (f"{name}: disk centres coincide at step {k}, t = {k * h:.9g} s, the contact "
+                              "normal is undefined"), n_done, None
+        state_txt = ", ".join(f"{name}:{STATE_NAMES[states[k - 1, i]] if k else 'initial'}"
+                              for i, name in enumerate(names))
+        where = f"step {k}, t = {k * h:.9g} s, contact states {state_txt}, q = {np.array2string(q[k], precision=6)}"
+        if self._solver_error is not None:
+            message = str(self._solver_error.with_context(where))
+        else:
+            message = f"{self.options.solver}: {_KERNEL_FAILURES.get(int(counters[loop.K_SOLVER_STATUS]), 'failed')} ({where})"
+        return "failed", message, n_done, Event(k * h, "solver-failure", "", {"message": message})
 
-    def _run_compiled(self, scene, q0, v0, n_steps, stop_index, names, t_end) -> SimulationResult:
-        opts = self.options
-        wall = time.process_time()
-        (q, v, pN, pT, states, n_done, code, fail_step, impact_t, impact_step, impact_contact, t_stop,
-         solves, inconsistent) = fast_moreau_jean.run_compiled(scene, q0, v0, opts.h, opts.theta, opts.activation_gamma,
-                                                       n_steps, -1 if stop_index is None else stop_index)
-        cpu = time.process_time() - wall
-        h = opts.h
-        events, impacts = [], []
-        minv = scene.inverse_mass_diagonal
-        f = scene.force(0.0, q[0], v[0])
-        for t_hit, k, i in zip(impact_t, impact_step, impact_contact):
-            k, i, t_hit = int(k), int(i), float(t_hit)
+    def _impacts(self, scene, out, names, n_done):
+        q, v, p_n, p_t = out[0], out[1], out[2], out[3]
+        impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
+        h, minv = self.options.h, scene.inverse_mass_diagonal
+        impacts, events = [], []
+        for n in range(min(int(counters[loop.K_N_IMPACTS]), impact_t.shape[0])):
+            k, i, t_hit = int(impact_step[n]), int(impact_contact[n]), float(impact_t[n])
             if k >= n_done:
                 continue
+            f = scene.force(k * h, q[k], v[k])
             v_hit = v[k] + (t_hit - k * h) * minv * f
             q_hit = q[k] + (t_hit - k * h) * v[k]
-            impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v[k + 1].copy(), pN[k].copy(), pT[k].copy()))
+            impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v[k + 1].copy(), p_n[k].copy(), p_t[k].copy()))
             events.append(Event(t_hit, "impact", names[i], {"step": k}))
-        status, message = "ok", f"reached t_end = {t_end:g} s"
-        t_stop = None if math.isnan(t_stop) else float(t_stop)
-        if t_stop is not None:
-            message = f"stopped at the impact of {opts.stop_at_impact}"
-        if code == fast_moreau_jean.RUN_SOLVER_FAILED:
-            k = int(fail_step)
-            state_txt = ", ".join(f"{names[i]}:{STATE_NAMES[states[k - 1, i]] if k else 'initial'}"
-                                  for i in range(len(names)))
-            status = "failed"
-            message = (f"lemke: no valid solution of the step problem (step {k}, t = {k * h:.9g} s, "
-                       f"contact states {state_txt}, q = {np.array2string(q[k], precision=6)})")
-            events.append(Event(k * h, "solver-failure", "", {"message": message}))
-        elif code == fast_moreau_jean.RUN_NONFINITE:
-            status, message = "failed", f"non-finite state at step {fail_step}, t = {fail_step * h:.9g} s"
-        return self._result(scene, q, v, pN, pT, states, int(n_done), h, names, events, impacts, status,
-                            message, cpu, t_stop,
-                            {"solves": int(solves), "inconsistent_steps": int(inconsistent), "h": h,
-                             "theta": opts.theta, "solver": opts.solver, "compiled": True})
+        return impacts, events
 
-    def _result(self, scene, q, v, pN, pT, states, n_done, h, names, events, impacts, status, message,
-                cpu, t_stop, stats) -> SimulationResult:
+    def _result(self, scene, packed, out, names, t_end, cpu, stats) -> SimulationResult:
+        h = self.options.h
+        status, message, n_done, failure = self._ending(out, names, t_end)
+        impacts, events = self._impacts(scene, out, names, n_done)
+        counters = out[9]
         t = np.arange(n_done + 1) * h
-        q, v = q[: n_done + 1], v[: n_done + 1]
+        q, v = out[0][: n_done + 1], out[1][: n_done + 1]
         a = np.full_like(v, np.nan)
         a[1:] = np.diff(v, axis=0) / h
         N = np.zeros((n_done + 1, len(names)))
         T = np.zeros_like(N)
-        N[1:] = pN[:n_done] / h
-        T[1:] = pT[:n_done] / h
+        N[1:], T[1:] = out[2][:n_done] / h, out[3][:n_done] / h
         modes = np.empty((n_done + 1, len(names)), dtype=object)
-        codes = states[:n_done]
-        modes[1:] = np.array(STATE_NAMES, dtype=object)[codes]
+        modes[1:] = np.array(STATE_NAMES, dtype=object)[out[5][:n_done]]
         modes[0] = modes[1] if n_done else "open"
-        bounds = t.copy()
-        if t_stop is not None and n_done >= 1:
-            bounds[-1] = max(t_stop, bounds[-2])
-        phases = {}
-        if n_done:
-            for ci, name in enumerate(names):
-                phases[name] = phases_from_intervals(bounds, list(modes[1:, ci]), self.options.min_phase)
+        t_stop = None
+        if int(counters[loop.K_STATUS]) == loop.RUN_STOPPED:
+            t_stop = max(i.t for i in impacts if i.contact == self.options.stop_at_impact)
+        phases, phase_events = located_phases(scene, out, packed, impacts, n_done, h, self.options.min_phase,
+                                              t_stop)
+        events = sorted(events + phase_events, key=lambda e: e.t) + ([failure] if failure else [])
+        stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
+                     solver_iterations=int(counters[loop.K_ITERATIONS]),
+                     inconsistent_steps=int(counters[loop.K_INCONSISTENT]))
         traj = Trajectory(t, q, v, a, N, T, modes)
-        stats = dict(stats, steps=n_done)
         return SimulationResult(self.name, status, message, traj, names, events, impacts, phases,
                                 steps=n_done, cpu_time_s=cpu, stats=stats)
 
 
-def _gap_to_close(gap: float, position_scale: float) -> float:
-    """The gap a persistent contact is asked to close in one step: none if it is position round-off.
+_KERNEL_FAILURES = {1: "no valid solution of the step problem (secondary ray)",
+                    2: "no valid solution of the step problem (no convergence)",
+                    3: "the step problem has more contacts than the solver takes",
+                    4: "non-finite data in the step problem"}
 
-    A gap of a few ulps of the positions is not a gap; closing it within the step asks the
-    contact for a velocity round-off/h that the body's other contacts cannot all follow (q_step
-    leaves the range of W), so a statically indeterminate body at rest would have to slip.
-    """
-    return gap if gap > GAP_ROUNDOFF * position_scale else 0.0
+
+def _state(name, value, n_dof):
+    array = np.array(value, dtype=float).reshape(-1)
+    if array.shape != (n_dof,) or not np.all(np.isfinite(array)):
+        raise InputError(f"{name} must be {n_dof} finite numbers (x, y, θ per body), got {value!r}")
+    return array
+
+
+# --- phase boundaries located inside the step ------------------------------------------------
+_BOUNDARY_KIND = {"open": "liftoff", "stick": "slip-zero"}  # by the mode entered; otherwise:
+SLIP_MODES = ("slip+", "slip-")
+
+
+def _crossing(values, level, k, h):
+    """Where the linear extrapolation of step impulses values[k−2], values[k−1] reaches `level`,
+    as an offset from t_k; None without a usable slope.
+
+    The impulse of step j that keeps a persistent contact closed answers the change of its
+    Jacobian from q_{j−1} to q_j (a backward difference): it is the force at t_j − h/2, not at
+    the step's midpoint (measured on the rolling rod: T/N of step j is the exact one at
+    t_j − 0.58 h in the paper's case 3, later in case 2); we take it at the step's start t_j."""
+    if k < 2:
+        return None
+    slope = (values[k - 1] - values[k - 2]) / h
+    if slope == 0.0:
+        return None
+    return (level - values[k - 1]) / slope - h
+
+
+def _boundary_offset(before, after, k, i, out, mu_s, h, slip_velocity):
+    """Offset from t_k of the switch before → after of contact i at step k (None: t_k).
+
+    Extrapolated from the last two steps spent in `before` (a one-step blip merged into a phase,
+    e.g. the stick step of a slip reversal, is skipped)."""
+    p_n, p_t, states = out[2][:, i], out[3][:, i], out[5][:, i]
+    j = k  # one past the last step in `before` whose predecessor is in `before` too
+    while j >= 2 and j > k - 3 and not (STATE_NAMES[states[j - 1]] == before == STATE_NAMES[states[j - 2]]):
+        j -= 1
+    if j < 2 or not (STATE_NAMES[states[j - 1]] == before == STATE_NAMES[states[j - 2]]):
+        return None
+    shift = (j - k) * h
+    if after == "open":  # the normal impulse fades to zero
+        offset = _crossing(p_n, 0.0, j, h)
+    elif before == "stick":  # the friction ratio reaches μs
+        ratio = np.abs(p_t[:j]) / np.maximum(p_n[:j], 1e-300)
+        offset = _crossing(ratio, mu_s, j, h)
+    else:  # slip → stick or reversal: the slip velocity at the steps' ends reaches zero
+        s1, s2 = slip_velocity(j - 1), slip_velocity(j)
+        slope = (s2 - s1) / h
+        # (it may already have crossed at t_j: the law judged H_T(q_j) v_{j+1}, not H_T(q_{j+1}))
+        offset = -s2 / slope if slope * s2 < 0.0 or s1 * s2 < 0.0 else None
+    return None if offset is None else offset + shift
+
+
+def located_phases(scene, out, packed, impacts, n_done, h, min_phase, t_stop):
+    """Per-contact phases with each boundary placed inside its step (interpolating the slip
+    velocity, the friction ratio or the normal impulse between steps; an impact's boundary at the
+    impact time), and one event per boundary."""
+    phases, events = {}, []
+    names = [c.name for c in scene.contacts]
+    if not n_done:
+        return phases, events
+    bounds = np.arange(n_done + 1) * h
+    if t_stop is not None and n_done >= 1:
+        bounds[-1] = max(float(t_stop), bounds[-2])
+    impact_time = {(imp.contact, int(round(imp.t / h))): imp.t for imp in impacts}
+    for i, name in enumerate(names):
+        codes = out[5][:n_done, i]
+        starts = np.r_[0, np.flatnonzero(codes[1:] != codes[:-1]) + 1]  # runs of one state
+        found = phases_from_intervals(np.r_[bounds[starts], bounds[-1]], [STATE_NAMES[c] for c in codes[starts]],
+                                      min_phase)
+        for before, after in zip(found, found[1:]):
+            k = int(round(after.t_start / h))
+            if before.mode == "open":
+                t_switch = min((t for (c, step), t in impact_time.items() if c == name and abs(step - k) <= 1),
+                               key=lambda t: abs(t - k * h), default=k * h)
+                kind = "impact"
+            else:
+                def slip_velocity(j, contact=scene.contacts[i]):  # with the Jacobian at q_j itself
+                    kin = contact.kinematics(out[0][j], out[1][j], scene.n_dof)
+                    return float(kin.H_T @ out[1][j]) - kin.surface_velocity
+
+                offset = _boundary_offset(before.mode, after.mode, k, i, out, packed.contacts[i, C_MU_S], h,
+                                          slip_velocity)
+                t_switch = k * h + (0.0 if offset is None else min(max(offset, -2 * h), h))
+                kind = _BOUNDARY_KIND.get(after.mode, "stick-slip")
+            t_switch = min(max(t_switch, before.t_start), after.t_end)
+            before.t_end = after.t_start = float(t_switch)
+            if kind != "impact":
+                events.append(Event(float(t_switch), kind, name,
+                                    {"from": before.mode, "to": after.mode, "step": k, "located": "interpolated"}))
+        phases[name] = found
+    return phases, events

@@ -24,6 +24,7 @@ class Scene:
     contacts: Sequence = ()
     gravity: float = 9.81
     applied_force: AppliedForce | None = None
+    forces: Sequence = ()  # model.forces: Spring, Damper, ConstantForce, RampedForce, TabulatedForce
 
     def __post_init__(self):
         require_finite("g", self.gravity)
@@ -33,6 +34,13 @@ class Scene:
             raise InputError("a scene needs at least one body")
         self.bodies = list(self.bodies)
         self.contacts = list(self.contacts)
+        from .forces import FORCE_TYPES  # here: forces.py imports the jit decorator
+
+        self.forces = list(self.forces)
+        for i, force in enumerate(self.forces):
+            if not isinstance(force, FORCE_TYPES):
+                raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce or "
+                                 f"TabulatedForce, got {type(force).__name__}")
         self._check_references()
         self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
         self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
@@ -58,19 +66,29 @@ class Scene:
             if contact.name in seen:
                 raise InputError(f"two contacts are named {contact.name!r}: contact names must be unique")
             seen.add(contact.name)
+        for i, force in enumerate(self.forces):
+            for attr in ("body", "body_a", "body_b"):
+                body = getattr(force, attr, None)
+                if body is not None and body >= len(self.bodies):
+                    raise InputError(f"forces[{i}] ({force.name!r}) {attr} refers to body {body}, but the scene "
+                                     f"has {len(self.bodies)} bodies")
 
     @property
     def n_dof(self) -> int:
         return 3 * len(self.bodies)
 
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        if self.applied_force is None:
-            return self.weight
-        force = np.asarray(self.applied_force(t, q, v), dtype=float)
-        if force.shape != self.weight.shape:
-            raise InputError(f"applied_force must return {self.n_dof} numbers (fx, fy, torque per body), "
-                             f"got shape {force.shape} at t = {t:g} s")
-        return self.weight + force
+        """Gravity + the `forces` + the `applied_force` callable at (t, q, v)."""
+        total = self.weight
+        for force in self.forces:
+            total = total + force.generalised_force(t, q, v, self.n_dof)
+        if self.applied_force is not None:
+            force = np.asarray(self.applied_force(t, q, v), dtype=float)
+            if force.shape != self.weight.shape:
+                raise InputError(f"applied_force must return {self.n_dof} numbers (fx, fy, torque per body), "
+                                 f"got shape {force.shape} at t = {t:g} s")
+            total = total + force
+        return total
 
     def kinematics(self, q: np.ndarray, v: np.ndarray):
         return [c.kinematics(q, v, self.n_dof) for c in self.contacts]

@@ -384,11 +384,6 @@ def _max_abs(values):
     return largest
 
 
-# Former names of the compiled kernels (fast_moreau_jean imports them).
-_lemke_kernel_jit = _lemke_kernel
-_lemke_friction_kernel_jit = _lemke_friction_kernel
-
-
 def _default_max_pivots(n):
     # Lemke typically needs O(n) pivots; exponential worst cases do not occur at n ≤ 12.
     return 50 + 20 * n

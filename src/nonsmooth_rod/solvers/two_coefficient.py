@@ -15,9 +15,7 @@ the contact slid with) until the impulses obey the exact law at the end-of-step 
 
 Because stick is accepted under any guess whenever |p_T| ≤ μs p_N, a sliding contact that comes
 to rest re-sticks in the very step in which μs can hold it, whatever h is: this is what the
-naive "μd if it slid last step" rule gets wrong. Once consistent, a contact that started the step
-at rest and slides is held instead if any admissible impulse split of the step can hold it
-(sticking.prefer_sticking: statically indeterminate contacts). See docs/friction.md.
+naive "μd if it slid last step" rule gets wrong. See docs/friction.md.
 """
 from __future__ import annotations
 
@@ -26,8 +24,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import solvers as _solvers
+from .._jit import jit
+# The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
+# Python (solve_two_coefficient below).
+from .kernels import KERNEL_SOLVED, SOLVER_CODES, pgs_block, solve_interval
+from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
-from .sticking import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking
+from .sticking import prefer_sticking
+
+COMPILED_SOLVERS = SOLVER_CODES  # solver name -> code of the compiled kernels
+
+# Contact state codes (API.md): open, stick, slip+, slip−.
+STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
+STATE_NAMES = ("open", "stick", "slip+", "slip-")
+# What the sign iteration does after a solve that was not consistent.
+NEXT_RETRY, NEXT_TRY_ZERO, NEXT_STOP = 0, 1, 2
+MAX_SOLVES = 6
 
 
 @dataclass
@@ -42,113 +54,228 @@ class StepContactResult:
     consistent: bool
 
 
-def classify(p: np.ndarray, u: np.ndarray, mu_s: np.ndarray, velocity_tol: float,
-             impulse_tol: float) -> tuple[list[str], np.ndarray, np.ndarray]:
-    """Contact states of a step solution, the slip signs they imply, and their consistency."""
-    n = len(mu_s)
-    states = []
-    signs = np.zeros(n)
-    consistent = np.ones(n, dtype=bool)
-    for i in range(n):
-        pN, pT, uT = p[2 * i], p[2 * i + 1], u[2 * i + 1]
-        if pN <= impulse_tol:
-            states.append("open")
-            continue
-        if uT > velocity_tol:
-            states.append("slip+")
-            signs[i] = 1.0
-        elif uT < -velocity_tol:
-            states.append("slip-")
-            signs[i] = -1.0
+@jit
+def classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
+    """States of a step solution under slip guess `guess`; True when the guess is consistent.
+
+    A contact is consistent when it opened, slid the way the guess said, or stuck inside the
+    static cone (under any guess). An inconsistent contact's new guess: a wrong non-zero guess
+    falls back to 0 (the ordinary μs problem, where sticking is tried first); only a contact that
+    slides even then takes the sign it slid with (or, sticking outside the cone, the sign that
+    opposes its friction). Jumping from one slip sign to the other could skip an admissible stick.
+    """
+    # A slip velocity within the solver's own accuracy is zero (iterative solvers leave
+    # residuals of 1e-12..1e-9; Lemke's is round-off).
+    v_tol = max(velocity_tol, 10.0 * residual)
+    scale_p = 1e-300
+    for r in range(p.shape[0]):
+        scale_p = max(scale_p, abs(p[r]))
+    p_tol = 1e-12 * scale_p
+    consistent = True
+    for j in range(guess.shape[0]):
+        p_n, p_t, u_t = p[2 * j], p[2 * j + 1], u[2 * j + 1]
+        implied = guess[j]
+        outside_cone = False
+        if p_n <= p_tol:
+            states[j] = STATE_OPEN
+        elif u_t > v_tol:
+            states[j] = STATE_SLIP_PLUS
+            implied = 1.0
+        elif u_t < -v_tol:
+            states[j] = STATE_SLIP_MINUS
+            implied = -1.0
         else:
-            states.append("stick")
-            # Sticking is admissible only inside the static cone; otherwise the contact slips
-            # against the friction it could not supply.
-            if abs(pT) > mu_s[i] * pN * (1 + 1e-9) + impulse_tol:
-                consistent[i] = False
-                signs[i] = -np.sign(pT)
-    return states, signs, consistent
+            states[j] = STATE_STICK
+            if abs(p_t) > mu_s[j] * p_n * (1 + 1e-9) + p_tol:  # outside the static cone
+                outside_cone = True
+                implied = -1.0 if p_t > 0.0 else (1.0 if p_t < 0.0 else 0.0)
+        new_guess[j] = guess[j]
+        if outside_cone or implied != guess[j]:
+            consistent = False
+            new_guess[j] = 0.0 if guess[j] != 0.0 else implied
+    return consistent
 
 
-_STATE_CODES = {"open": STATE_OPEN, "stick": STATE_STICK, "slip+": STATE_SLIP_PLUS, "slip-": STATE_SLIP_MINUS}
-_STATE_NAMES = ("open", "stick", "slip+", "slip-")
+@jit
+def _seen(tried, n_tried, guess):
+    for k in range(n_tried):
+        same = True
+        for j in range(guess.shape[0]):
+            if tried[k, j] != guess[j]:
+                same = False
+        if same:
+            return True
+    return False
 
 
-def _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, start_guess, velocity_tol, closing,
-                             result: StepContactResult) -> None:
-    """A contact that started at rest slides only if no admissible split holds it (sticking.py):
-    replace `result` by the solution that holds the most of them, when the step has one."""
-    if not any(s != "stick" and g == 0.0 for s, g in zip(result.states, start_guess)):
-        return  # no contact that started at rest moves: nothing to hold (the common step)
-    closing = np.zeros(len(mu_s)) if closing is None else np.asarray(closing, dtype=float)
-    codes = np.array([_STATE_CODES[s] for s in result.states], dtype=np.int64)
-    p, u = np.array(result.p, dtype=float), np.array(result.u, dtype=float)
-    if prefer_sticking(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float), mu_s, mu_d,
-                       np.array(start_guess, dtype=float), float(velocity_tol), closing, p, u, codes):
-        result.p, result.u = p, u
-        result.states = [_STATE_NAMES[c] for c in codes]
-        result.slip_signs = np.where(codes == STATE_SLIP_PLUS, 1.0, np.where(codes == STATE_SLIP_MINUS, -1.0, 0.0))
+@jit
+def next_action(new_guess, tried, n_tried):
+    """After an inconsistent solve: retry with new_guess, or — cycling between guesses (possible
+    only with several interacting contacts) or out of solves — solve the ordinary μs problem
+    once (exact for sticking; the caller counts the step as inconsistent), or stop."""
+    if n_tried < tried.shape[0] - 1 and not _seen(tried, n_tried, new_guess):
+        return NEXT_RETRY
+    for j in range(new_guess.shape[0]):
+        new_guess[j] = 0.0
+    return NEXT_STOP if _seen(tried, n_tried, new_guess) else NEXT_TRY_ZERO
+
+
+@jit
+def _interval_of(mu_s, mu_d, guess, lo, hi):
+    """The friction interval [c − μs, c + μs], c = (μs − μd) s, of slip guess s."""
+    for j in range(guess.shape[0]):
+        shift = (mu_s[j] - mu_d[j]) * guess[j]
+        lo[j] = shift - mu_s[j]
+        hi[j] = shift + mu_s[j]
+
+
+@jit
+def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval on the dense W, or pgs_block when the block-sparse W is given (indptr)."""
+    if indptr.shape[0] > 0:
+        return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+    return solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+
+
+# Statically indeterminate holds are searched on a dense W; pgs scenes larger than this (piles,
+# rows of hundreds of balls) keep the solver's split rather than densify every such step.
+MAX_DENSE_HOLD = 64
+
+
+@jit
+def _dense_of(indptr, indices, blocks, na):
+    """The dense W of solvers.kernels' block-sparse layout."""
+    W = np.zeros((2 * na, 2 * na))
+    for i in range(na):
+        for k in range(indptr[i], indptr[i + 1]):
+            j = indices[k]
+            for a in range(2):
+                for b in range(2):
+                    W[2 * i + a, 2 * j + b] = blocks[k, a, b]
+    return W
+
+
+@jit
+def _guess_of_states(states, guess):
+    for i in range(states.shape[0]):
+        guess[i] = 1.0 if states[i] == STATE_SLIP_PLUS else (-1.0 if states[i] == STATE_SLIP_MINUS else 0.0)
+
+
+@jit
+def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
+    """Hold what μs can hold (sticking.prefer_sticking) when a contact that started the step at
+    rest does not stick; True when p, u, states were replaced. The common step returns at once."""
+    na = mu_s.shape[0]
+    moving = False
+    for i in range(na):
+        if start_guess[i] == 0.0 and states[i] != STATE_STICK:
+            moving = True
+    if not moving:
+        return False
+    if W.shape[0] == 0:
+        if na > MAX_DENSE_HOLD:
+            return False
+        W = _dense_of(indptr, indices, blocks, na)
+    return prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states)
+
+
+@jit
+def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, rtol, max_iter,
+                           p, u, states):
+    """The exact two-coefficient law on u = W p + q, from slip guess `guess` (updated in place to
+    the converged guess). W is dense (m × m), or empty with its block-sparse form (indptr,
+    indices, blocks: solvers.kernels' layout) for pgs. p holds the warm start (pgs). `closing`
+    (per contact): the gap-closing part g/h of q_N, which a held body may leave open. Once the
+    sign iteration is consistent, a contact that started at rest slides only if no admissible
+    impulse split holds it (hold_at_rest).
+    Returns (kernel status, solves, solver iterations, consistent)."""
+    na = guess.shape[0]
+    start_guess = guess.copy()
+    lo, hi, new_guess = np.empty(na), np.empty(na), np.empty(na)
+    tried = np.empty((MAX_SOLVES + 1, na))
+    scale_v = 1e-12
+    for r in range(2 * na):
+        scale_v = max(scale_v, abs(q[r]))
+    velocity_tol = 1e-9 * scale_v
+    n_tried, iterations, consistent = 0, 0, False
+    while True:
+        tried[n_tried] = guess
+        n_tried += 1
+        _interval_of(mu_s, mu_d, guess, lo, hi)
+        status, its, residual = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+        iterations += its
+        if status != KERNEL_SOLVED:
+            return status, n_tried, iterations, False
+        if classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
+            consistent = True
+            break
+        action = next_action(new_guess, tried, n_tried)
+        guess[:] = new_guess
+        if action == NEXT_RETRY:
+            continue
+        if action == NEXT_TRY_ZERO:
+            _interval_of(mu_s, mu_d, guess, lo, hi)
+            status, its, residual = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+            iterations += its
+            n_tried += 1
+            if status != KERNEL_SOLVED:
+                return status, n_tried, iterations, False
+            classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess)
+        break
+    if consistent and hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess,
+                                   max(velocity_tol, 10.0 * residual), closing, p, u, states):
+        _guess_of_states(states, guess)
+    return KERNEL_SOLVED, n_tried, iterations, consistent
 
 
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
                           slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
-                          max_solves: int = 6, closing: np.ndarray | None = None) -> StepContactResult:
-    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`.
-
-    `closing` (per contact, default 0): the gap-closing velocity g/h included in q_N, which a
-    held statically indeterminate body may leave unclosed (sticking.prefer_sticking)."""
-    mu_s = np.asarray(mu_s, dtype=float)
-    mu_d = np.asarray(mu_d, dtype=float)
+                          max_solves: int = MAX_SOLVES, closing: np.ndarray | None = None) -> StepContactResult:
+    """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`, with
+    any solver of solvers.solve (the same rule as two_coefficient_kernel: classify_solution and
+    next_action, hold_at_rest). `closing` (per contact, default 0): the gap-closing part g/h of
+    q_N, which a held body may leave open. Raises the solver's SolverError when a solve fails."""
+    W = np.ascontiguousarray(W, dtype=float)
+    q = np.ascontiguousarray(q, dtype=float)
+    mu_s = np.ascontiguousarray(mu_s, dtype=float)
+    mu_d = np.ascontiguousarray(mu_d, dtype=float)
     guess = np.array(slip_guess, dtype=float)
-    scale_v = max(1e-12, float(np.max(np.abs(q))))
-    velocity_tol = 1e-9 * scale_v
-    tried = set()
-    iterations = 0
-    best = None
-    for solves in range(1, max_solves + 1):
-        key = tuple(guess)
-        tried.add(key)
-        shift = (mu_s - mu_d) * guess
-        problem = PlanarFrictionProblem(W, q, shift - mu_s, shift + mu_s)
-        sol = _solvers.solve(problem, solver, **(solver_options or {}))
+    start_guess = guess.copy()
+    na = guess.shape[0]
+    closing = np.zeros(na) if closing is None else np.ascontiguousarray(closing, dtype=float)
+    classify, action_of = interpreted(classify_solution), interpreted(next_action)
+    lo, hi, new_guess, states = np.empty(na), np.empty(na), np.empty(na), np.zeros(na, dtype=np.int64)
+    tried = np.empty((max_solves + 1, na))
+    velocity_tol = 1e-9 * max(1e-12, float(np.max(np.abs(q), initial=0.0)))
+    n_tried, iterations, consistent = 0, 0, False
+    while True:
+        tried[n_tried] = guess
+        n_tried += 1
+        interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
+        sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
         iterations += sol.iterations
-        p, u = sol.p, sol.u
-        scale_p = max(1e-300, float(np.max(np.abs(p))))
-        # A slip velocity within the solver's own accuracy is zero (iterative and QP
-        # solvers leave residuals of 1e-12..1e-9; Lemke's is round-off).
-        step_velocity_tol = max(velocity_tol, 10.0 * sol.residual)
-        states, implied, ok = classify(p, u, mu_s, step_velocity_tol, 1e-12 * scale_p)
-        # A guess is consistent for a contact when the step slid the way the guess said, or
-        # stuck inside the static cone (any guess), or opened.
-        for i, st in enumerate(states):
-            if st in ("slip+", "slip-") and implied[i] != guess[i]:
-                ok[i] = False
-        best = StepContactResult(p, u, states, guess.copy(), solves, iterations, sol.residual, bool(ok.all()))
-        if ok.all():
-            _hold_what_mu_s_can_hold(W, q, mu_s, mu_d, slip_guess, step_velocity_tol, closing, best)
-            return best
-        # A wrong non-zero guess falls back to 0 (the ordinary μs problem, where sticking is
-        # tried first); only a contact that slides even then takes the sign it slid with.
-        # Jumping straight from one slip sign to the other could skip an admissible stick.
-        new_guess = guess.copy()
-        for i in range(len(guess)):
-            if not ok[i]:
-                new_guess[i] = 0.0 if guess[i] != 0.0 else implied[i]
-        if tuple(new_guess) in tried:
+        if classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess):
+            consistent = True
             break
-        guess = new_guess
-    # Cycling between guesses (possible only with several interacting contacts): keep the
-    # ordinary μs solution, which is exact for sticking, and let the caller count it.
-    if best is not None and not best.consistent:
-        zero = np.zeros_like(guess)
-        if tuple(zero) not in tried:
-            problem = PlanarFrictionProblem(W, q, -mu_s, mu_s)
-            sol = _solvers.solve(problem, solver, **(solver_options or {}))
-            states, implied, _ = classify(sol.p, sol.u, mu_s, max(velocity_tol, 10.0 * sol.residual),
-                                          1e-12 * max(1e-300, np.max(np.abs(sol.p))))
-            best = StepContactResult(sol.p, sol.u, states, zero, best.solves + 1,
-                                     iterations + sol.iterations, sol.residual, False)
-    return best
+        action = action_of(new_guess, tried, n_tried)
+        guess[:] = new_guess
+        if action == NEXT_RETRY:
+            continue
+        if action == NEXT_TRY_ZERO:
+            interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
+            sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
+            iterations += sol.iterations
+            n_tried += 1
+            classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess)
+        break
+    p, u = np.array(sol.p, dtype=float), np.array(sol.u, dtype=float)
+    empty = np.zeros(0, dtype=np.int64)
+    if consistent and hold_at_rest(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess,
+                                   max(velocity_tol, 10.0 * sol.residual), closing, p, u, states):
+        interpreted(_guess_of_states)(states, guess)
+    return StepContactResult(p, u, [STATE_NAMES[s] for s in states], guess.copy(), n_tried, iterations,
+                             float(sol.residual), consistent)
 
 
-__all__ = ["solve_two_coefficient", "StepContactResult", "classify", "SolverError"]
+__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "StepContactResult", "classify_solution",
+           "next_action", "solve_interval", "SolverError", "STATE_NAMES"]

@@ -1,0 +1,208 @@
+"""Microseconds per Moreau–Jean step on every kind of scene, and the engine's cold compile time.
+
+    python benchmarks/bench_scenes.py [--quick] [--repeats 5] [--no-compile-time] [--max-balls 256] [--only NAME]
+
+Scenes: the paper's rod, each toy, a frictionless ladder (2 contacts, 1 body), a row of N balls
+on a floor (N − 1 disk–disk and N disk–floor contacts, the first ball rolling into the others),
+and a pyramid pile of disks on a floor — with lemke and pgs (lemke only up to 32 contacts: its
+dense tableau grows as contacts³). Each run is timed whole (CPU time / steps, median of the
+repeats) next to the yardstick, one 3×3 numpy.linalg.solve in a Python loop, timed in the same
+run; ratios are what to read on a shared machine. MuJoCo (mj_step) steps the ball rows and the
+pile when `mujoco` is installed (optional extra `bench`); PyBullet likewise when `pybullet` is.
+
+The cold compile time is a subprocess with an empty NUMBA_CACHE_DIR running one short rod run
+(issue 16's target: ≤ 5 s on an idle 2-core machine).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from nonsmooth_rod import toys
+from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+from nonsmooth_rod.model.body import RigidBody
+from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLine
+from nonsmooth_rod.model.laws import ContactLaw
+from nonsmooth_rod.model.scene import Scene
+from nonsmooth_rod.rod.problem import RodProblem
+
+LEMKE_MAX_CONTACTS = 32
+BALL_RADIUS, BALL_MASS = 0.05, 0.1
+
+
+def yardstick_us(n: int = 20000, repeats: int = 5) -> float:
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((3, 3)) + 3 * np.eye(3)
+    b = rng.standard_normal(3)
+    times = []
+    for _ in range(repeats):
+        t0 = time.process_time()
+        for _ in range(n):
+            np.linalg.solve(A, b)
+        times.append((time.process_time() - t0) / n * 1e6)
+    return statistics.median(times)
+
+
+def ball_row(n: int):
+    """N balls on a floor, 1 mm apart, the first rolling at 1 m/s into the others."""
+    law = ContactLaw.of(0.3, 0.2, 0.0)
+    bodies = [RigidBody(BALL_MASS, 0.4 * BALL_MASS * BALL_RADIUS**2, f"ball{i}") for i in range(n)]
+    contacts = [DiskOnLine(i, (0.0, 0.0), Line(), BALL_RADIUS, law, f"floor{i}") for i in range(n)]
+    contacts += [DiskOnDisk(i + 1, i, BALL_RADIUS, BALL_RADIUS, law=law, name=f"{i}-{i + 1}") for i in range(n - 1)]
+    q0 = np.zeros(3 * n)
+    q0[0::3] = np.arange(n) * (2 * BALL_RADIUS + 1e-3)
+    q0[1::3] = BALL_RADIUS
+    v0 = np.zeros(3 * n)
+    v0[0], v0[2] = 1.0, -1.0 / BALL_RADIUS
+    return Scene(bodies, contacts), q0, v0
+
+
+def pile(rows: int):
+    """A pyramid of disks resting on a floor: each disk on the two below it."""
+    law = ContactLaw.of(0.5, 0.4, 0.0)
+    centres, index = [], {}
+    for r in range(rows):
+        for c in range(rows - r):
+            index[r, c] = len(centres)
+            centres.append(((2 * c + r) * BALL_RADIUS, BALL_RADIUS * (1 + r * math.sqrt(3))))
+    bodies = [RigidBody(BALL_MASS, 0.4 * BALL_MASS * BALL_RADIUS**2, f"disk{i}") for i in range(len(centres))]
+    contacts = [DiskOnLine(index[0, c], (0.0, 0.0), Line(), BALL_RADIUS, law, f"floor{c}") for c in range(rows)]
+    for (r, c), i in index.items():
+        if r > 0:
+            contacts += [DiskOnDisk(i, index[r - 1, c + k], BALL_RADIUS, BALL_RADIUS, law=law, name=f"{i}/{k}")
+                         for k in (0, 1)]
+    q0 = np.zeros(3 * len(centres))
+    q0[0::3], q0[1::3] = zip(*centres)
+    return Scene(bodies, contacts), q0, np.zeros_like(q0)
+
+
+def ladder():
+    law = ContactLaw.of(0.0, 0.0)
+    phi = math.radians(60.0)
+    contacts = [PointOnLine(0, (0.5, 0.0), Line((0.0, 0.0), -math.pi / 2), law, "top"),
+                PointOnLine(0, (-0.5, 0.0), Line(), law, "bottom")]
+    q0 = np.array([0.25, 0.5 * math.sin(phi), math.pi - phi])
+    return Scene([RigidBody(1.0, 1.0 / 12)], contacts), q0, np.zeros(3)
+
+
+def scenes(max_balls: int, quick: bool):
+    rod = RodProblem.paper(2)
+    yield "rod (paper case 2)", (rod.scene(), *rod.initial_state())
+    for name in ("BouncingBall", "BlockOnIncline", "PushedBlock", "DiskOnIncline", "BeltOscillator",
+                 "RockingBlock", "PainleveRod", "BallRow"):
+        toy = getattr(toys, name)()
+        yield f"toy {name}", (toy.scene(), *toy.initial_state())
+    yield "ladder", ladder()
+    n = 2
+    while n <= max_balls:
+        yield f"ball row N={n}", ball_row(n)
+        n *= 4 if quick else 2
+    yield "pile 4 rows", pile(4)
+    if not quick:
+        yield "pile 8 rows", pile(8)
+
+
+def step_us(scene, q0, v0, solver, h, steps, repeats):
+    options = MoreauJeanOptions(h=h, solver=solver)
+    run = MoreauJean(options).run(scene, q0, v0, h * steps)  # warm-up: compiles on first use
+    if run.status != "ok":
+        return math.nan, run
+    times = []
+    for _ in range(repeats):
+        t0 = time.process_time()
+        run = MoreauJean(options).run(scene, q0, v0, h * steps)
+        times.append((time.process_time() - t0) / run.steps * 1e6)
+    return statistics.median(times), run
+
+
+def mujoco_step_us(scene_name, n, steps, repeats, h):
+    """mj_step per step on the same ball row / pile (spheres on a plane, planar not enforced)."""
+    try:
+        import mujoco
+    except ImportError:
+        return None
+    if scene_name.startswith("ball row"):
+        bodies = "".join(f'<body pos="{i * (2 * BALL_RADIUS + 1e-3)} 0 {BALL_RADIUS}"><freejoint/>'
+                         f'<geom type="sphere" size="{BALL_RADIUS}" mass="{BALL_MASS}"/></body>' for i in range(n))
+    else:
+        return None
+    xml = (f'<mujoco><option timestep="{h}"/><worldbody><geom type="plane" size="10 10 0.1"/>{bodies}'
+           '</worldbody></mujoco>')
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    data.qvel[0] = 1.0
+    times = []
+    for _ in range(repeats):
+        mujoco.mj_resetData(model, data)
+        data.qvel[0] = 1.0
+        t0 = time.process_time()
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+        times.append((time.process_time() - t0) / steps * 1e6)
+    return statistics.median(times)
+
+
+def cold_compile_seconds() -> float:
+    """Wall time of a fresh process with an empty numba cache running one short rod run, minus
+    the same process with a warm cache (imports and the run itself)."""
+    code = ("from nonsmooth_rod.rod.problem import RodProblem;"
+            "from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions;"
+            "p = RodProblem.paper(2); q0, v0 = p.initial_state();"
+            "MoreauJean(MoreauJeanOptions(h=1e-2)).run(p.scene(), q0, v0, 0.05)")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.join(os.path.dirname(__file__), "..", "src"),
+                                                         os.environ.get("PYTHONPATH", "")]))
+    with tempfile.TemporaryDirectory() as cache:
+        env["NUMBA_CACHE_DIR"] = cache
+        walls = []
+        for _ in range(2):  # cold, then warm (cache hit)
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-c", code], env=env, check=True)
+            walls.append(time.perf_counter() - t0)
+    return walls[0], walls[1]
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="few steps, N = 2, 8, 32, one pile, 2 repeats")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--max-balls", type=int, default=None)
+    parser.add_argument("--no-compile-time", action="store_true")
+    parser.add_argument("--only", default="", help="run only the scenes whose name contains this")
+    args = parser.parse_args(argv)
+    repeats = 2 if args.quick else args.repeats
+    max_balls = args.max_balls or (32 if args.quick else 256)
+    h, steps = 1e-3, (50 if args.quick else 500)
+    yard = yardstick_us(repeats=repeats)
+    print(f"yardstick (3x3 numpy.linalg.solve in a Python loop): {yard:.2f} us")
+    print(f"{'scene':28s} {'contacts':>8s} {'solver':>6s} {'us/step':>10s} {'x yardstick':>11s}  compiled")
+    for name, (scene, q0, v0) in scenes(max_balls, args.quick):
+        if args.only not in name:
+            continue
+        nc = len(scene.contacts)
+        for solver in ("lemke", "pgs"):
+            if solver == "lemke" and nc > LEMKE_MAX_CONTACTS:
+                continue
+            us, run = step_us(scene, q0, v0, solver, h, steps, repeats)
+            note = "" if run.status == "ok" else f"  {run.status}: {run.message[:60]}"
+            print(f"{name:28s} {nc:8d} {solver:>6s} {us:10.1f} {us / yard:11.2f}  {run.stats['compiled']}{note}")
+        if name.startswith("ball row"):
+            mj = mujoco_step_us(name, len(scene.bodies), steps, repeats, h)
+            if mj is not None:
+                print(f"{name:28s} {nc:8d} {'mujoco':>6s} {mj:10.1f} {mj / yard:11.2f}  mj_step")
+    if not args.no_compile_time:
+        cold, warm = cold_compile_seconds()
+        print(f"first run, empty numba cache: {cold:.1f} s ({cold * 1e6 / yard:.2g} yardsticks); "
+              f"with the cache: {warm:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
