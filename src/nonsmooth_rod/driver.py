@@ -144,11 +144,25 @@ def _check_output_size(method: str, opts, scene: Scene, duration: float, save_ev
 
 
 def _shifted(scene: Scene, t0: float) -> Scene:
-    """The scene with time-dependent applied forces read at t0 + t (integrators start at 0)."""
-    if not t0 or scene.applied_force is None:
+    """The scene with its time-dependent forces read at t0 + t (integrators start at 0)."""
+    if not t0:
         return scene
-    force = scene.applied_force
-    return dataclasses.replace(scene, applied_force=lambda t, q, v: force(t + t0, q, v))
+    forces = [_force_shifted(force, t0) for force in scene.forces]
+    applied = scene.applied_force
+    if applied is not None:
+        def applied_at_absolute_time(t, q, v):
+            return applied(t + t0, q, v)
+    return dataclasses.replace(scene, forces=forces,
+                               applied_force=None if applied is None else applied_at_absolute_time)
+
+
+def _force_shifted(force, t0: float):
+    """A force data object whose clock starts at t0 (ramps and tables move back by t0)."""
+    if hasattr(force, "t_start") and hasattr(force, "t_full"):
+        return dataclasses.replace(force, t_start=force.t_start - t0, t_full=force.t_full - t0)
+    if hasattr(force, "times"):
+        return dataclasses.replace(force, times=tuple(t - t0 for t in force.times))
+    return force
 
 
 def _shift_times(result: SimulationResult, t0: float) -> None:

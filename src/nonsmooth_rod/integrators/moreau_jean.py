@@ -149,7 +149,7 @@ class MoreauJean:
         for k in range(n_steps):
             kernels.step_force(k, params, model, out, f)
             if scene.applied_force is not None:
-                f += np.asarray(scene.applied_force((k + th) * h, q[k], v[k]), dtype=float)
+                f += scene.applied((k + th) * h, q[k], v[k])
             if iparams[loop.I_SOLVER] >= 0:
                 status = kernels.compiled_step(k, f, params, iparams, model, work, out)
             else:

@@ -83,12 +83,16 @@ class Scene:
         for force in self.forces:
             total = total + force.generalised_force(t, q, v, self.n_dof)
         if self.applied_force is not None:
-            force = np.asarray(self.applied_force(t, q, v), dtype=float)
-            if force.shape != self.weight.shape:
-                raise InputError(f"applied_force must return {self.n_dof} numbers (fx, fy, torque per body), "
-                                 f"got shape {force.shape} at t = {t:g} s")
-            total = total + force
+            total = total + self.applied(t, q, v)
         return total
+
+    def applied(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The `applied_force` callable at (t, q, v), checked: n_dof finite numbers."""
+        force = np.asarray(self.applied_force(t, q, v), dtype=float)
+        if force.shape != self.weight.shape:
+            raise InputError(f"applied_force must return {self.n_dof} numbers (fx, fy, torque per body), "
+                             f"got shape {force.shape} at t = {t:g} s")
+        return force
 
     def kinematics(self, q: np.ndarray, v: np.ndarray):
         return [c.kinematics(q, v, self.n_dof) for c in self.contacts]
