@@ -18,7 +18,7 @@ from ._jit import compiling_notice
 from .integrators import METHODS, integrator_classes, supported_contacts
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
-from .validation import InputError, require_finite, require_positive
+from .validation import InputError, require_finite, require_positive, require_state
 
 # Refuse a run whose saved output would exceed this (bytes), before allocating anything.
 MAX_OUTPUT_BYTES = 4 * 2**30
@@ -47,8 +47,8 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     """
     if not isinstance(scene, Scene):
         raise InputError(f"scene must be a nonsmooth_rod.Scene, got {type(scene).__name__}")
-    q0 = _state_vector("q0", q0, scene.n_dof)
-    v0 = _state_vector("v0", v0, scene.n_dof)
+    q0 = require_state("q0", q0, scene.n_dof)
+    v0 = require_state("v0", v0, scene.n_dof)
     t0 = require_finite("t0", t0)
     t_end = require_finite("t_end", t_end)
     if t_end <= t0:
@@ -68,20 +68,6 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     if save_every is not None:
         _decimate(result, require_positive("save_every", save_every))
     return result
-
-
-def _state_vector(name: str, value, n_dof: int) -> np.ndarray:
-    if value is None:
-        raise InputError(f"{name} must be a sequence of {n_dof} numbers (x, y, θ per body), got None")
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a sequence of {n_dof} numbers, got {value!r}") from None
-    if arr.shape != (n_dof,):
-        raise InputError(f"{name} must hold {n_dof} numbers (x, y, θ per body), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise InputError(f"{name} must be finite, got {arr.tolist()!r}")
-    return arr.copy()
 
 
 def _method(method, scene: Scene):

@@ -74,3 +74,20 @@ def require_point(name: str, value) -> tuple[float, float]:
     if len(items) != 2:
         raise InputError(f"{name} must be two numbers (x, y), got {len(items)}: {value!r}")
     return (require_finite(f"{name} x", items[0]), require_finite(f"{name} y", items[1]))
+
+
+def require_state(name: str, value, n_dof: int):
+    """An initial state q0 or v0: exactly n_dof finite numbers (x, y, θ per body), as float64."""
+    import numpy as np
+
+    if value is None:
+        raise InputError(f"{name} must be a sequence of {n_dof} numbers (x, y, θ per body), got None")
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a sequence of {n_dof} numbers, got {value!r}") from None
+    if array.shape != (n_dof,):
+        raise InputError(f"{name} must hold {n_dof} numbers (x, y, θ per body), got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise InputError(f"{name} must be finite, got {array.tolist()!r}")
+    return array

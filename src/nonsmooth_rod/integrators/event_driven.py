@@ -47,7 +47,7 @@ from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
-from ..validation import InputError, require_positive
+from ..validation import InputError, require_positive, require_state
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
@@ -341,18 +341,6 @@ def _force_scale(scene, t, q, v) -> float:
     return max(1e-12, float(np.max(np.abs(scene.force(t, q, v)))))
 
 
-def _state_vector(name, value, n) -> np.ndarray:
-    try:
-        x = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a vector of {n} numbers, got {value!r}") from None
-    if x.shape != (n,):
-        raise InputError(f"{name} must have {n} entries (x, y, θ of each body), got shape {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise InputError(f"{name} must be finite, got {x.tolist()}")
-    return x
-
-
 class EventDriven:
     """Event-driven integrator for scenes whose contacts are disks or points on lines."""
 
@@ -458,7 +446,7 @@ class EventDriven:
             raise InputError(f"output_dt = {self.options.output_dt!r} s over t_end = {t_end!r} s asks for "
                              f"{n_samples:.3g} samples ({n_samples * per_sample / 2**30:.3g} GiB); use "
                              f"output_dt ≥ {t_end * per_sample / MAX_OUTPUT_BYTES:.3g} s")
-        return _state_vector("q0", q0, scene.n_dof), _state_vector("v0", v0, scene.n_dof)
+        return require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
 
     def _loop(self, scene, run, modes, t_end, names):
         """Segments and switches until t_end (or a stop); returns (status, message)."""

@@ -30,7 +30,7 @@ from ..solvers import available_solvers
 from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
-from ..validation import InputError, require_in_range, require_positive
+from ..validation import InputError, require_in_range, require_positive, require_state
 from . import moreau_jean_loop as loop
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 
@@ -115,7 +115,7 @@ class MoreauJean:
         opts = self.options
         n_steps = max(1, int(math.ceil(t_end / opts.h - 1e-9)))
         names = [c.name for c in scene.contacts]
-        q0, v0 = _state("q0", q0, scene.n_dof), _state("v0", v0, scene.n_dof)
+        q0, v0 = require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
         packed = pack_scene(scene)
         model, work, out = _allocate(packed, q0, v0, n_steps)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
@@ -256,13 +256,6 @@ _KERNEL_FAILURES = {1: "no valid solution of the step problem (secondary ray)",
                     2: "no valid solution of the step problem (no convergence)",
                     3: "the step problem has more contacts than the solver takes",
                     4: "non-finite data in the step problem"}
-
-
-def _state(name, value, n_dof):
-    array = np.array(value, dtype=float).reshape(-1)
-    if array.shape != (n_dof,) or not np.all(np.isfinite(array)):
-        raise InputError(f"{name} must be {n_dof} finite numbers (x, y, θ per body), got {value!r}")
-    return array
 
 
 # --- phase boundaries located inside the step ------------------------------------------------
