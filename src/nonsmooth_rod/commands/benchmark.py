@@ -50,7 +50,7 @@ def cmd_benchmark(args) -> int:
     from pathlib import Path
 
     from ..rod import study
-    from ..io import write_csv, write_text
+    from ..io import provenance, write_csv, write_json, write_text
 
     cases = _parse_list(args.cases, "cases", int)
     methods = _parse_list(args.methods, "methods")
@@ -77,6 +77,9 @@ def cmd_benchmark(args) -> int:
     records = study.run_specs(specs, refs, time_limit, workers=args.jobs, progress=progress)
     rows = study.stability_records(records, refs)
     write_csv(out / "work_precision.csv", study.work_precision_table(records), study.CSV_COLUMNS)
+    # CSV has no place for metadata: where the tables came from goes next to them
+    write_json(out / "provenance.json", {"files": ["work_precision.csv", "stability.csv"], "cases": cases,
+                                         "methods": methods, "quick": args.quick, "provenance": provenance()})
     write_csv(out / "stability.csv", study.stability_table(rows), study.STABILITY_COLUMNS)
     study.plot_work_precision(records, out / "work_precision.png")
     extras = []
