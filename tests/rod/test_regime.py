@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from nonsmooth_rod.rod import regime
+from nonsmooth_rod.rod import regime, regime_figure
 from nonsmooth_rod.rod.problem import RodGeometry, RodProblem
 from nonsmooth_rod.rod.plotting import axis
 from nonsmooth_rod.rod.regime import (
@@ -94,13 +94,13 @@ def test_at_30_degrees_the_start_is_the_maximum_so_no_r1_region(tmp_path):
 
 
 def test_map_cells_and_boundaries(small_sweep):
-    from nonsmooth_rod.rod.regime import regime_map_figure
+    from nonsmooth_rod.rod.regime_figure import regime_map_figure
 
     fig = regime_map_figure(small_sweep.grid_rows, Grid(MU_S, np.array([60.0]), mu_d_ratio=0.75), BASE,
                             small_sweep.thresholds)
     ax = axis(fig, "map")
     mesh = ax.collections[0]
-    names, code = regime._scenario_codes(small_sweep.grid_rows)
+    names, code = regime_figure._scenario_codes(small_sweep.grid_rows)
     cells = np.asarray(mesh.get_array()).ravel()
     assert [names[int(c)] for c in cells] == [r["scenario"] for r in small_sweep.grid_rows]
     for gid, value in (("T_over_N_initial", 0.26278), ("T_over_N_max", 0.29003)):
@@ -324,7 +324,7 @@ def test_dask_local_cluster_with_resume(tmp_path):
 
 
 def test_every_cell_of_the_map_is_filled_for_unrounded_tilts(tmp_path):
-    from nonsmooth_rod.rod.regime import regime_map_figure
+    from nonsmooth_rod.rod.regime_figure import regime_map_figure
 
     grid = Grid(np.array([0.2, 0.3, 0.4]), np.linspace(40.0, 50.0, 4), mu_d_ratio=0.75)  # 43.333…°
     res = sweep(BASE, grid, tmp_path, jobs=1, plot=False, check_points=0)
@@ -335,14 +335,14 @@ def test_every_cell_of_the_map_is_filled_for_unrounded_tilts(tmp_path):
 
 @pytest.mark.parametrize("y", ["mu_d_ratio", "theta0_deg"])
 def test_map_over_two_axes_shows_every_point_of_that_plane(tmp_path, y):
-    from nonsmooth_rod.rod.regime import axes_map_figure
+    from nonsmooth_rod.rod.regime_figure import axes_map_figure
 
     mu = np.array([0.2, 0.27, 0.3, 0.4])
     grid = Grid(mu, np.array([45.0, 60.0]), mu_d_ratio=np.array([0.5, 0.8, 1.0]))
     res = sweep(BASE, grid, tmp_path, jobs=1, plot=False, check_points=0)
     ax = axis(axes_map_figure(res.grid_rows, grid, BASE, x="mu_s", y=y), "map")
     cells = ax.collections[0].get_array()
-    names, _ = regime._scenario_codes(res.grid_rows)
+    names, _ = regime_figure._scenario_codes(res.grid_rows)
     held = "theta0_deg" if y == "mu_d_ratio" else "mu_d_ratio"
     plane = [r for r in res.grid_rows if r[held] == min(r2[held] for r2 in res.grid_rows)]
     assert cells.size == len(plane) == 4 * (3 if y == "mu_d_ratio" else 2) and not np.ma.is_masked(cells)

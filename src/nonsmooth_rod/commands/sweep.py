@@ -146,12 +146,12 @@ def cmd_sweep(args) -> int:
 def _map_axes_option(text, grid) -> tuple:
     if text is None:
         return (None, None)
-    from ..rod.regime import _map_axes
+    from ..rod.regime_figure import map_axes_of
 
     parts = [t.strip().replace("-", "_") for t in text.split(",")]
     if len(parts) != 2:
         raise InputError(f"--map-axes: expected X,Y, got {text!r}")
-    return _map_axes(grid, *parts)
+    return map_axes_of(grid, *parts)
 
 
 def _report(result) -> None:
