@@ -73,8 +73,9 @@ def test_plastic_ball_stops_at_its_first_impact():
 
 
 def _hops_resolved(ball, h):
-    """Upper bound on the impacts Moreau–Jean resolves: rebounds continue while the incoming
-    speed e^k v_1 exceeds about g h (a slower one cannot leave the floor within a step), plus 2."""
+    """Upper bound on the impacts Moreau–Jean resolves: no rebound leaves the floor once the
+    incoming speed e^k v_1 is below about g h/e (it stays within h² g of the floor, where the
+    contact stays closed); plus 2."""
     e = ball.restitution
     return math.log(ball.impact_speed / (ball.g * h)) / math.log(1 / e) + 2
 
