@@ -5,7 +5,7 @@
 Issue 14's bar: |Δq| < 1e-10 after 1e5 steps for each toy that statics can hold (ladder just
 above its critical angle, block on two corners just below tan α = μs, rod wedged between two
 walls, pyramid of three disks). Prints max |q − q0| over the run, whether every contact stuck in
-every step, and the CPU time; exits 1 if any toy moved. --quick: 200 steps (a test runs it).
+every step, and the CPU time; exits 1 if any toy moved. --quick: 50 steps (a test runs it).
 """
 from __future__ import annotations
 
@@ -46,9 +46,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=100_000)
     parser.add_argument("--h", type=float, default=1e-3)
-    parser.add_argument("--quick", action="store_true", help="200 steps")
+    parser.add_argument("--quick", action="store_true", help="50 steps")
     args = parser.parse_args(argv)
-    steps = 200 if args.quick else args.steps
+    steps = 50 if args.quick else args.steps
     print(f"max |q - q0| over {steps} steps of h = {args.h:g} (bar: {HOLD_TOL:g})")
     print(f"{'toy':<28}{'solver':<18}{'max|dq|':>10}{'all stick':>11}{'cpu s':>8}")
     failed = 0

@@ -37,7 +37,7 @@ def test_ball_file_builds_the_toy_scene():
     sf = load_scene(SCENES / "bouncing_ball.toml")
     toy = toys.BouncingBall()
     body, = sf.scene.bodies
-    assert body.mass == toy.mass and body.inertia == pytest.approx(0.4 * toy.mass * toy.radius**2, rel=1e-15)
+    assert body.mass == toy.mass and body.inertia == pytest.approx(0.4 * toy.mass * toy.radius**2, rel=1e-13)
     q0, v0 = toy.initial_state()
     np.testing.assert_array_equal(sf.q0, q0)
     np.testing.assert_array_equal(sf.v0, v0)
@@ -50,9 +50,9 @@ def test_paper_rod_file_matches_rod_problem():
     sf = load_scene(SCENES / "paper_rod.toml")
     p = RodProblem.paper()
     body, = sf.scene.bodies
-    assert body.mass == pytest.approx(p.mass, rel=1e-14) and body.inertia == pytest.approx(p.inertia, rel=1e-14)
+    assert body.mass == pytest.approx(p.mass, rel=1e-13) and body.inertia == pytest.approx(p.inertia, rel=1e-13)
     q0, _ = p.initial_state()
-    np.testing.assert_allclose(sf.q0, q0, rtol=1e-15)
+    np.testing.assert_allclose(sf.q0, q0, rtol=1e-13)
     assert [c.offset for c in sf.scene.contacts] == [(-p.xi, 0.0), (p.length - p.xi, 0.0)]
     assert sf.stop == ["B"]
 
@@ -68,14 +68,14 @@ def test_shapes_give_the_textbook_inertia(shape, dims, inertia):
     data["bodies"][0] = {"name": "ball", "shape": shape, "mass": 2.0, **dims}
     data["contacts"] = []
     sf = parse_scene(data)
-    assert sf.scene.bodies[0].inertia == pytest.approx(inertia, rel=1e-15)
+    assert sf.scene.bodies[0].inertia == pytest.approx(inertia, rel=1e-13)
     assert sf.shapes["ball"] == {"shape": shape, **dims}
 
 
 def test_density_gives_the_mass_of_a_steel_ball():
     data = copy.deepcopy(BALL)
     data["bodies"][0] = {"name": "ball", "shape": "ball", "radius": 0.02, "density": 7800.0}
-    assert parse_scene(data).scene.bodies[0].mass == pytest.approx(7800 * 4 / 3 * math.pi * 0.02**3, rel=1e-15)
+    assert parse_scene(data).scene.bodies[0].mass == pytest.approx(7800 * 4 / 3 * math.pi * 0.02**3, rel=1e-13)
 
 
 def test_json_and_toml_read_the_same(tmp_path):
@@ -104,7 +104,7 @@ def test_spring_force_pulls_towards_its_anchor_with_k_times_stretch():
     f = spring.generalised_force(0.0, q, v, 3)
     tension = 100.0 * 0.3 + 2.0 * 0.5  # k stretch + c d(stretch)/dt
     # force (-tension, 0) at the lever (0, -0.1): torque (0)(0) - (-0.1)(-tension) = -0.1 tension
-    np.testing.assert_allclose(f, [-tension, 0.0, -0.1 * tension], rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(f, [-tension, 0.0, -0.1 * tension], rtol=0, atol=500 * np.finfo(float).eps * tension)
 
 
 def test_ramped_force_scales_linearly_between_its_times():

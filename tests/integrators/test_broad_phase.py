@@ -31,7 +31,8 @@ def test_all_pairs_listed_give_the_neighbours_run():
     pair_impacts = [i.contact for i in neighbours.impacts if not i.contact.startswith("floor")]
     assert pair_impacts[:5] == ["0-1", "1-2", "2-3", "3-4", "4-5"]  # the impulse runs down the row
     assert [i.contact for i in everything.impacts] == [i.contact for i in neighbours.impacts]
-    assert np.max(np.abs(everything.trajectory.q - neighbours.trajectory.q)) <= 1e-13
+    q = neighbours.trajectory.q  # the far pairs stay open: the same run to round-off of its positions
+    assert np.max(np.abs(everything.trajectory.q - q)) <= 500 * np.finfo(float).eps * np.max(np.abs(q))
     far = [name for name in everything.contact_names if name not in neighbours.contact_names]
     assert len(far) == 10 and all(not everything.phases[n] or {p.mode for p in everything.phases[n]} == {"open"}
                                   for n in far)

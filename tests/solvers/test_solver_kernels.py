@@ -53,7 +53,9 @@ def test_lemke_kernel_is_lemke_friction(problem):
     status, pivots, residual, p, u = run(SOLVER_LEMKE, problem)
     reference = lemke_friction(problem)
     assert status == KERNEL_SOLVED and pivots == reference.iterations
-    np.testing.assert_array_equal(p, reference.p)
+    # the same pivots; compiled and interpreted arithmetic may differ by FMA and summation order
+    scale = residual_scale(problem, reference.p, reference.u)
+    np.testing.assert_allclose(p, reference.p, rtol=0, atol=500 * np.finfo(float).eps * scale)
 
 
 @pytest.mark.parametrize("code", SOLVER_CODES)
@@ -110,7 +112,8 @@ def test_pgs_block_equals_pgs_on_the_dense_matrix():
     p, u = np.zeros(4), np.zeros(4)
     status, sweeps, _ = pgs_block(*dense_to_blocks(problem.W), problem.q, problem.lo, problem.hi, p, u, 0.0, 0)
     assert status == status_dense == KERNEL_SOLVED and sweeps == sweeps_dense
-    np.testing.assert_array_equal(p, p_dense)
+    scale = residual_scale(problem, p_dense, u)  # the same sweeps over differently stored blocks
+    np.testing.assert_allclose(p, p_dense, rtol=0, atol=500 * np.finfo(float).eps * scale)
 
 
 @pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed: only the interpreted kernels exist")

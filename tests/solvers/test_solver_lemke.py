@@ -150,7 +150,7 @@ def assert_step_solution(problem, solution, tol=TOL):
     scale = residual_scale(problem, solution.p, solution.u)
     assert complementarity_residual(problem, solution.p) <= tol * scale
     assert solution.residual <= tol * scale
-    assert abs(solution.residual - complementarity_residual(problem, solution.p)) <= 1e-14 * scale
+    assert abs(solution.residual - complementarity_residual(problem, solution.p)) <= 500 * np.finfo(float).eps * scale
 
 
 @pytest.mark.parametrize("formulation", ["interval", "cone"])
@@ -208,7 +208,8 @@ def test_block_with_two_corners_on_incline(jit, formulation, angle, mu, states):
     normal_total = solution.normal_impulse.sum()
     assert normal_total == pytest.approx(0.0981 * np.cos(angle), rel=1e-9)
     if states[0] == "stick":
-        assert solution.tangential_impulse.sum() == pytest.approx(-0.0981 * np.sin(angle), rel=1e-9, abs=1e-15)
+        assert solution.tangential_impulse.sum() == pytest.approx(-0.0981 * np.sin(angle), rel=1e-9,
+                                                                  abs=500 * np.finfo(float).eps * normal_total)
 
 
 def test_degenerate_step_with_zero_free_velocity_components():

@@ -67,7 +67,7 @@ def test_wedged_rod_is_held_when_some_split_can_hold_it(compiled):
     mu_s, mu_d = np.full(2, 0.7), np.full(2, 0.5)
     assert run(W, q, mu_s, mu_d, np.zeros(2), 1e-9 * np.max(np.abs(q)), np.zeros(2), p, u, states)
     assert list(states) == [STATE_STICK, STATE_STICK]
-    np.testing.assert_allclose(u, W @ p + q, atol=1e-15)
+    np.testing.assert_allclose(u, W @ p + q, rtol=0, atol=500 * np.finfo(float).eps * np.max(np.abs(q)))
     assert np.max(np.abs(u)) < 1e-12 * np.max(np.abs(q))  # at rest at the end of the step
     pN, pT = p[0::2], p[1::2]
     assert np.all(pN > 0) and np.all(np.abs(pT) < 0.7 * pN)  # strictly inside both cones
@@ -102,7 +102,7 @@ def test_only_contacts_that_started_at_rest_are_held(start_guess, held):
                               np.zeros(1), p, u, states)
     assert changed == held
     if held:  # a contact at rest starts sliding only when μs cannot hold it
-        assert states[0] == STATE_STICK and abs(u[1]) < 1e-15 and p[1] == pytest.approx(-mass * v)
+        assert states[0] == STATE_STICK and abs(u[1]) < 500 * np.finfo(float).eps * v and p[1] == pytest.approx(-mass * v)
     else:  # a sliding contact keeps sliding while the law allows it (the sign iteration's choice)
         assert states[0] == STATE_SLIP_PLUS and u[1] > 0
 
@@ -150,4 +150,5 @@ def test_a_held_body_leaves_a_round_off_gap_open(told):
     assert held == told
     if told:
         assert list(states) == [STATE_STICK, STATE_STICK]
-        assert u[0] == pytest.approx(closing[0], rel=1e-6) and abs(u[2]) < 1e-15  # H_N v = 0 on both
+        # H_N v = 0 on both, to round-off of the step's velocities
+        assert u[0] == pytest.approx(closing[0], rel=1e-6) and abs(u[2]) < 500 * np.finfo(float).eps * np.max(np.abs(q))

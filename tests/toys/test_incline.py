@@ -73,7 +73,7 @@ def test_block_launched_up_stops_then_resticks_or_slides_back(h, degrees):
     assert 0.0 <= run.t[stopped] - block.stop_time <= h
     after = run.t > block.stop_time + 2 * h
     if block.holds:
-        assert np.max(np.abs(ds[after])) < 1e-15
+        assert np.max(np.abs(ds[after])) < 500 * np.finfo(float).eps * block.v0  # at rest to round-off
         assert np.ptp(s[after]) < 1e-12  # no creep
     else:
         back = np.polyfit(run.t[after], ds[after], 1)[0]
