@@ -66,6 +66,45 @@ def test_sigkill_of_a_sweep_leaves_no_worker():
     assert survivors == []
 
 
+def _descendants(pid: int) -> list[int]:
+    found, todo = [], [pid]
+    while todo:
+        for child in _children(todo.pop()):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+def test_sigkill_of_a_dask_sweep_leaves_no_worker_or_scheduler():
+    """The Dask executor's LocalCluster (worker processes) with work under way: SIGKILL the
+    process that started it, and none of its processes may survive it by more than a few seconds."""
+    pytest.importorskip("distributed")
+    script = textwrap.dedent("""
+        import time
+        from nonsmooth_rod.executors import open_executor
+        with open_executor("dask", 2) as (pool, workers):
+            futures = [pool.submit(time.sleep, 60) for _ in range(4)]
+            time.sleep(1.0)
+            print("busy", flush=True)
+            time.sleep(60)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], env=os.environ | {"PYTHONPATH": SRC},
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "busy", proc.stderr.read()[-2000:]
+    spawned = _descendants(proc.pid)
+    assert len(spawned) >= 2  # the cluster's worker processes
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(_alive(p) for p in spawned):
+        time.sleep(0.2)
+    survivors = [p for p in spawned if _alive(p)]
+    for p in survivors:  # clean up before failing
+        os.kill(p, signal.SIGKILL)
+    assert survivors == []
+
+
 def test_dask_local_cluster_opens_and_closes():
     pytest.importorskip("distributed")
     with open_executor("dask", jobs=1, processes=False) as (executor, workers):
