@@ -71,7 +71,7 @@ class MoreauJeanOptions:
             raise InputError(f"min_phase must be non-negative, got {self.min_phase!r}")
 
 
-_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
+_ENTRY_POINTS = ("run_steps_lemke", "run_steps_pgs", "run_steps_enum", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
 
 
 def loop_kernels(compiled: bool):
@@ -132,7 +132,7 @@ class MoreauJean:
         self._solver_error = None
         wall = time.process_time()
         if not callback and solver_code is not None:
-            kernels.run_steps(0, n_steps, params, iparams, model, work, out)
+            getattr(kernels, loop.RUN_STEPS[solver_code])(0, n_steps, params, iparams, model, work, out)
         else:
             self._run_stepwise(kernels, scene, n_steps, params, iparams, model, work, out)
         cpu = time.process_time() - wall
