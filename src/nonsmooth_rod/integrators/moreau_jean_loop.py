@@ -241,11 +241,13 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
     for d in range(vk.shape[0]):
         gap_roundoff = max(gap_roundoff, abs(qk[d]))
     gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
+    block = np.empty((2, 2))  # C-contiguous like delassus_blocks' blocks: _fill_block compiles once
     for a in range(na):
         i = active[a]
         for b in range(na if W.shape[0] > 0 else 0):  # dense W: for lemke and enum
             j = active[b]
-            _fill_block(W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2], hn, ht, index, i, j, minv)
+            _fill_block(block, hn, ht, index, i, j, minv)
+            W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2] = block
         surface = table[i, C_SURFACE_VELOCITY]
         q_step[2 * a + 1] = local_dot(ht[i], index, i, v_free) - surface
         mu_s[a], mu_d[a] = table[i, C_MU_S], table[i, C_MU_D]
