@@ -10,7 +10,7 @@ A step of size h from (q_k, v_k), for a packed scene (model.packing):
                  impacts, contact memory
 
 `run_steps_lemke`, `run_steps_pgs`, `run_steps_enum` (one entry per solver) run them for a range of steps with the packed forces (the whole run is one
-compiled call); `compiled_step` runs one step with a force given by the caller (the step-wise
+compiled call); `compiled_step_lemke` (… `_pgs`, `_enum`) runs one step with a force given by the caller (the step-wise
 loop that calls back a Python `applied_force`). Arrays are grouped in three tuples so every
 kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
 (records). Their layouts are built by `allocate` in moreau_jean.py.
@@ -413,15 +413,9 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
 
 
 @_inlined
-def compiled_step(k, f, params, iparams, model, work, out):
-    """One whole step with generalised force f; returns a run status."""
-    return _step(iparams[I_SOLVER], k, f, params, iparams, model, work, out)
-
-
-@_inlined
 def _step(solver_code, k, f, params, iparams, model, work, out):
-    """compiled_step with the solver code as an argument: a literal one (run_steps_lemke …)
-    compiles that solver only."""
+    """One whole step with generalised force f; returns a run status. A literal solver code
+    (run_steps_lemke, compiled_step_lemke, …) compiles that solver only."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
     na = begin_step(params, qk, vk, f, model, work)
@@ -493,6 +487,30 @@ def run_steps_enum(k_start, k_end, params, iparams, model, work, out):
 RUN_STEPS = {SOLVER_LEMKE: "run_steps_lemke", SOLVER_PGS: "run_steps_pgs", SOLVER_ENUM: "run_steps_enum"}
 
 
-__all__ = ["begin_step", "assemble", "solve_step", "finish_step", "compiled_step", "step_force", "run_steps_lemke",
-           "run_steps_pgs", "run_steps_enum", "RUN_STEPS",
+# The same for the step-wise loop (a Python applied_force called back between steps).
+@jit
+def compiled_step_lemke(k, f, params, iparams, model, work, out):
+    """One step (_step) with lemke."""
+    return _step(SOLVER_LEMKE, k, f, params, iparams, model, work, out)
+
+
+@jit
+def compiled_step_pgs(k, f, params, iparams, model, work, out):
+    """One step (_step) with pgs."""
+    return _step(SOLVER_PGS, k, f, params, iparams, model, work, out)
+
+
+@jit
+def compiled_step_enum(k, f, params, iparams, model, work, out):
+    """One step (_step) with enum."""
+    return _step(SOLVER_ENUM, k, f, params, iparams, model, work, out)
+
+
+COMPILED_STEP = {SOLVER_LEMKE: "compiled_step_lemke", SOLVER_PGS: "compiled_step_pgs",
+                 SOLVER_ENUM: "compiled_step_enum"}
+
+
+__all__ = ["begin_step", "assemble", "solve_step", "finish_step", "step_force", "run_steps_lemke",
+           "run_steps_pgs", "run_steps_enum", "RUN_STEPS", "compiled_step_lemke", "compiled_step_pgs",
+           "compiled_step_enum", "COMPILED_STEP",
            "crossing_offset", "ACTIVATION_ROUNDOFF"]
