@@ -74,7 +74,7 @@ __all__ = ["jit", "ENABLED"]
 # The first compiled run on a fresh install compiles the engine (seconds); later processes load
 # it from the cache. A marker next to the cache records that compiling has happened for this
 # version, so the CLI can say "compiling the engine, once" only when it really will.
-COMPILE_ESTIMATE_S = 10  # measured by benchmarks/bench_startup.py on the 2-core reference machine
+COMPILE_ESTIMATE_S = 45  # benchmarks/bench_startup.py: 46.8 s cold (lemke, rod) on the 2 shared cores at load 2.5
 _notifier = None
 
 

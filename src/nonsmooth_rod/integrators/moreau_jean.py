@@ -71,7 +71,8 @@ class MoreauJeanOptions:
             raise InputError(f"min_phase must be non-negative, got {self.min_phase!r}")
 
 
-_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
+_ENTRY_POINTS = ("run_steps_lemke", "run_steps_pgs", "run_steps_enum", "compiled_step_lemke",
+                 "compiled_step_pgs", "compiled_step_enum", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
 
 
 def loop_kernels(compiled: bool):
@@ -132,7 +133,7 @@ class MoreauJean:
         self._solver_error = None
         wall = time.process_time()
         if not callback and solver_code is not None:
-            kernels.run_steps(0, n_steps, params, iparams, model, work, out)
+            getattr(kernels, loop.RUN_STEPS[solver_code])(0, n_steps, params, iparams, model, work, out)
         else:
             self._run_stepwise(kernels, scene, n_steps, params, iparams, model, work, out)
         cpu = time.process_time() - wall
@@ -146,12 +147,14 @@ class MoreauJean:
         q, v, counters = out[0], out[1], out[9]
         h, th = params[loop.P_H], params[loop.P_THETA]
         f = np.empty(scene.n_dof)
+        solver_code = int(iparams[loop.I_SOLVER])
+        compiled_step = getattr(kernels, loop.COMPILED_STEP[solver_code]) if solver_code >= 0 else None
         for k in range(n_steps):
             kernels.step_force(k, params, model, out, f)
             if scene.applied_force is not None:
                 f += scene.applied((k + th) * h, q[k], v[k])
-            if iparams[loop.I_SOLVER] >= 0:
-                status = kernels.compiled_step(k, f, params, iparams, model, work, out)
+            if compiled_step is not None:
+                status = compiled_step(k, f, params, iparams, model, work, out)
             else:
                 status = self._python_solver_step(kernels, k, f, params, iparams, model, work, out)
             if kernels.end_of_step(k, status, counters) != loop.RUN_OK:

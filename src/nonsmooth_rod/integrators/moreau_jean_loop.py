@@ -9,8 +9,8 @@ A step of size h from (q_k, v_k), for a packed scene (model.packing):
     finish_step  v_{k+1} = v_free + M⁻¹ Hᵀ p, q_{k+1} = q_k + h((1−θ) v_k + θ v_{k+1}), records,
                  impacts, contact memory
 
-`run_steps` runs them for a range of steps with the packed forces (the whole run is one
-compiled call); `compiled_step` runs one step with a force given by the caller (the step-wise
+`run_steps_lemke`, `run_steps_pgs`, `run_steps_enum` (one entry per solver) run them for a range of steps with the packed forces (the whole run is one
+compiled call); `compiled_step_lemke` (… `_pgs`, `_enum`) runs one step with a force given by the caller (the step-wise
 loop that calls back a Python `applied_force`). Arrays are grouped in three tuples so every
 kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
 (records). Their layouts are built by `allocate` in moreau_jean.py.
@@ -37,7 +37,7 @@ from ..model.forces import accumulate_forces
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
                              KIND_DISK_ON_DISK,
                              contact_kinematics, local_dot)
-from ..solvers.kernels import SOLVER_PGS
+from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
                                        two_coefficient_kernel)
 
@@ -241,11 +241,13 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
     for d in range(vk.shape[0]):
         gap_roundoff = max(gap_roundoff, abs(qk[d]))
     gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
+    block = np.empty((2, 2))  # C-contiguous like delassus_blocks' blocks: _fill_block compiles once
     for a in range(na):
         i = active[a]
         for b in range(na if W.shape[0] > 0 else 0):  # dense W: for lemke and enum
             j = active[b]
-            _fill_block(W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2], hn, ht, index, i, j, minv)
+            _fill_block(block, hn, ht, index, i, j, minv)
+            W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2] = block
         surface = table[i, C_SURFACE_VELOCITY]
         q_step[2 * a + 1] = local_dot(ht[i], index, i, v_free) - surface
         mu_s[a], mu_d[a] = table[i, C_MU_S], table[i, C_MU_D]
@@ -384,10 +386,10 @@ def _warm_start(k, na, work, out, p):
 
 
 @_inlined
-def solve_step(k, params, iparams, na, qk, vk, model, work, out):
+def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
     """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
     m = 2 * na
-    sparse = iparams[I_SOLVER] == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
+    sparse = solver_code == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
     W = np.zeros((0, 0)) if sparse else np.zeros((m, m))
     q_step = np.empty(m)
     guess, mu_s, mu_d, closing = np.empty(na), np.empty(na), np.empty(na), np.empty(na)
@@ -400,7 +402,7 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
     _warm_start(k, na, work, out, p)
     states = np.zeros(na, dtype=np.int64)
     status, solves, iterations, consistent = two_coefficient_kernel(
-        iparams[I_SOLVER], W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, params[P_RTOL],
+        solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, params[P_RTOL],
         iparams[I_MAX_ITER], p, u, states)
     counters = out[9]
     counters[K_SOLVES] += solves
@@ -411,8 +413,9 @@ def solve_step(k, params, iparams, na, qk, vk, model, work, out):
 
 
 @_inlined
-def compiled_step(k, f, params, iparams, model, work, out):
-    """One whole step with generalised force f; returns a run status."""
+def _step(solver_code, k, f, params, iparams, model, work, out):
+    """One whole step with generalised force f; returns a run status. A literal solver code
+    (run_steps_lemke, compiled_step_lemke, …) compiles that solver only."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
     na = begin_step(params, qk, vk, f, model, work)
@@ -421,7 +424,7 @@ def compiled_step(k, f, params, iparams, model, work, out):
         return RUN_BAD_GEOMETRY
     p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
     if na > 0:
-        status, p, u, states = solve_step(k, params, iparams, na, qk, vk, model, work, out)
+        status, p, u, states = solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out)
         if status != KERNEL_SOLVED:
             counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
@@ -451,15 +454,63 @@ def end_of_step(k, status, counters):
 
 
 @jit
-def run_steps(k_start, k_end, params, iparams, model, work, out):
+def _run(solver_code, k_start, k_end, params, iparams, model, work, out):
     """Steps k_start … k_end − 1 with the packed forces: the whole run in one call."""
     f = np.empty(model[0].shape[0])
     for k in range(k_start, k_end):
         step_force(k, params, model, out, f)
-        if end_of_step(k, compiled_step(k, f, params, iparams, model, work, out), out[9]) != RUN_OK:
+        if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out), out[9]) != RUN_OK:
             return out[9][K_STATUS]
     return RUN_OK
 
 
-__all__ = ["begin_step", "assemble", "solve_step", "finish_step", "compiled_step", "step_force", "run_steps",
+# One compiled entry per solver (the code passed as a literal): a first run compiles the loop
+# with its own solver only, not all three (issue 16).
+@jit
+def run_steps_lemke(k_start, k_end, params, iparams, model, work, out):
+    """_run with lemke."""
+    return _run(SOLVER_LEMKE, k_start, k_end, params, iparams, model, work, out)
+
+
+@jit
+def run_steps_pgs(k_start, k_end, params, iparams, model, work, out):
+    """_run with pgs."""
+    return _run(SOLVER_PGS, k_start, k_end, params, iparams, model, work, out)
+
+
+@jit
+def run_steps_enum(k_start, k_end, params, iparams, model, work, out):
+    """_run with enum."""
+    return _run(SOLVER_ENUM, k_start, k_end, params, iparams, model, work, out)
+
+
+RUN_STEPS = {SOLVER_LEMKE: "run_steps_lemke", SOLVER_PGS: "run_steps_pgs", SOLVER_ENUM: "run_steps_enum"}
+
+
+# The same for the step-wise loop (a Python applied_force called back between steps).
+@jit
+def compiled_step_lemke(k, f, params, iparams, model, work, out):
+    """One step (_step) with lemke."""
+    return _step(SOLVER_LEMKE, k, f, params, iparams, model, work, out)
+
+
+@jit
+def compiled_step_pgs(k, f, params, iparams, model, work, out):
+    """One step (_step) with pgs."""
+    return _step(SOLVER_PGS, k, f, params, iparams, model, work, out)
+
+
+@jit
+def compiled_step_enum(k, f, params, iparams, model, work, out):
+    """One step (_step) with enum."""
+    return _step(SOLVER_ENUM, k, f, params, iparams, model, work, out)
+
+
+COMPILED_STEP = {SOLVER_LEMKE: "compiled_step_lemke", SOLVER_PGS: "compiled_step_pgs",
+                 SOLVER_ENUM: "compiled_step_enum"}
+
+
+__all__ = ["begin_step", "assemble", "solve_step", "finish_step", "step_force", "run_steps_lemke",
+           "run_steps_pgs", "run_steps_enum", "RUN_STEPS", "compiled_step_lemke", "compiled_step_pgs",
+           "compiled_step_enum", "COMPILED_STEP",
            "crossing_offset", "ACTIVATION_ROUNDOFF"]

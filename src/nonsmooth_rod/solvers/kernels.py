@@ -78,23 +78,64 @@ def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots):
 
 
 @jit
+def _screen(W, q, lo, hi, p, u):
+    """The status of a problem no solver needs to see (non-finite data: p = 0, u = q; no
+    contacts), or −1 when a solver must run."""
+    if not (all_finite(W) and all_finite(q) and all_finite(lo) and all_finite(hi)):
+        p[:] = 0.0
+        u[:] = q
+        return KERNEL_NONFINITE
+    if q.shape[0] == 0:
+        return KERNEL_SOLVED
+    return -1
+
+
+@jit
+def _screened(status):
+    """(status, iterations, residual) of a problem `_screen` answered."""
+    return status, 0, (np.inf if status == KERNEL_NONFINITE else 0.0)
+
+
+# One entry per solver: a loop specialised to one solver compiles only that one (issue 16).
+@jit
+def solve_lemke(W, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval with SOLVER_LEMKE."""
+    status = _screen(W, q, lo, hi, p, u)
+    if status >= 0:
+        return _screened(status)
+    return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter)
+
+
+@jit
+def solve_pgs(W, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval with SOLVER_PGS."""
+    status = _screen(W, q, lo, hi, p, u)
+    if status >= 0:
+        return _screened(status)
+    return pgs_dense(W, q, lo, hi, p, u, rtol, max_iter)
+
+
+@jit
+def solve_enum(W, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval with SOLVER_ENUM (max_iter has no meaning for enum)."""
+    status = _screen(W, q, lo, hi, p, u)
+    if status >= 0:
+        return _screened(status)
+    return enum_interval(W, q, lo, hi, p, u, rtol, 0)
+
+
+@jit
 def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
     """Solve the dense step problem with solver SOLVER_LEMKE | SOLVER_PGS | SOLVER_ENUM.
 
     Fills p, u in place; returns (status, iterations, residual) (module docstring).
     """
-    if not (all_finite(W) and all_finite(q) and all_finite(lo) and all_finite(hi)):
-        p[:] = 0.0
-        u[:] = q
-        return KERNEL_NONFINITE, 0, np.inf
-    if q.shape[0] == 0:
-        return KERNEL_SOLVED, 0, 0.0
     if solver_code == SOLVER_LEMKE:
-        return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter)
+        return solve_lemke(W, q, lo, hi, p, u, rtol, max_iter)
     if solver_code == SOLVER_PGS:
-        return pgs_dense(W, q, lo, hi, p, u, rtol, max_iter)
+        return solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
     if solver_code == SOLVER_ENUM:
-        return enum_interval(W, q, lo, hi, p, u, rtol, 0)  # max_iter: no meaning for enum
+        return solve_enum(W, q, lo, hi, p, u, rtol, max_iter)
     p[:] = 0.0  # an unknown solver code: nothing solved
     u[:] = q
     return KERNEL_NO_CONVERGENCE, 0, np.inf
@@ -103,5 +144,5 @@ def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
 __all__ = [
     "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
     "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
-    "solve_interval", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
+    "solve_interval", "solve_lemke", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
 ]

@@ -145,7 +145,7 @@ def _first_leaving_row(T, n, rhs):
     """Entering z0 drives w up by z0·d; the row that leaves is the lexicographic minimum of
     (q_i, e_i): the most negative q_i, ties to the LARGEST index (e_i is lexicographically
     smaller for larger i). −1 when q ≥ 0 (z = 0 solves the LCP)."""
-    r = -1
+    r = np.int64(-1)  # not a literal: numba would compile the callees for the literal −1 too
     q_min = 0.0
     for i in range(n):
         value = T[i, rhs]
@@ -194,7 +194,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
         for i in range(n):
             column_max = max(column_max, abs(T[i, entering]))
         pivot_tol = PIVOT_TOL * column_max
-        r = -1
+        r = np.int64(-1)
         for i in range(n):
             if T[i, entering] > pivot_tol and (r < 0 or _lex_smaller(T, i, r, entering, n)):
                 r = i

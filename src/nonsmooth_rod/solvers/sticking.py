@@ -70,7 +70,7 @@ def _run_simplex(T, basis, n_allowed, max_iter):
                 break
         if j < 0:
             return 0
-        r = -1
+        r = np.int64(-1)  # not a literal: numba would compile _pivot for the literal −1 too
         best = np.inf
         for i in range(m):
             if T[i, j] > PIVOT_TOL:
@@ -101,7 +101,7 @@ def simplex_max(c, G, h, x):
         T[i, -1] = h[i]
         basis[i] = n + 1 + i
     max_iter = 50 * (n + m + 2)
-    worst = 0
+    worst = np.int64(0)
     for i in range(m):
         if h[i] < h[worst]:
             worst = i

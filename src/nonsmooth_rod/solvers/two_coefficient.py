@@ -24,10 +24,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import solvers as _solvers
+from .. import _jit
 from .._jit import jit
 # The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
 # Python (solve_two_coefficient below).
-from .kernels import KERNEL_SOLVED, SOLVER_CODES, pgs_block, solve_interval
+from .kernels import (KERNEL_SOLVED, SOLVER_CODES, SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, pgs_block, solve_enum,
+                      solve_interval, solve_lemke, solve_pgs)
 from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
 from .sticking import prefer_sticking
@@ -129,12 +131,37 @@ def _interval_of(mu_s, mu_d, guess, lo, hi):
         hi[j] = shift + mu_s[j]
 
 
-@jit
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval on the dense W, or pgs_block when the block-sparse W is given (indptr)."""
+    """solve_interval on the dense W, or pgs_block when the block-sparse W is given (indptr).
+
+    Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
+    that solver (`_solve_compiled`); lemke and enum then take the dense W."""
     if indptr.shape[0] > 0:
         return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
     return solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+
+
+_solve.py_func = _solve  # so solvers._common.interpreted rebinds the kernels it calls
+
+if _jit.ENABLED:
+    from numba.extending import overload
+
+    @overload(_solve, prefer_literal=True)
+    def _solve_compiled(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+        """_solve for numba: one solver for a literal solver code (a cold compile then skips the
+        others: issue 16), the run-time dispatch otherwise."""
+        dense = {SOLVER_LEMKE: solve_lemke, SOLVER_ENUM: solve_enum}.get(getattr(solver_code, "literal_value", None))
+        if dense is not None:
+            def solve_dense(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+                return dense(W, q, lo, hi, p, u, rtol, max_iter)
+            return solve_dense
+        if getattr(solver_code, "literal_value", None) == SOLVER_PGS:
+            def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+                if indptr.shape[0] > 0:
+                    return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+                return solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
+            return solve_pgs_either
+        return _solve
 
 
 # Statically indeterminate holds are searched on a dense W; pgs scenes larger than this (piles,

@@ -1,0 +1,34 @@
+"""benchmarks/bench_startup.py --quick runs (timings are not asserted), and a Moreau–Jean run of
+a scene leaves the heavy imports alone (issue 16)."""
+import importlib.util
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_bench_startup_quick_runs(capsys):
+    spec = importlib.util.spec_from_file_location("bench_startup", ROOT / "benchmarks" / "bench_startup.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert [line.split()[1] for line in out.splitlines() if line.startswith("import ")] == list(module.ENTRY_POINTS)
+    ratios = [float(line.split()[-1]) for line in out.splitlines() if line.startswith("rod h=")]
+    assert len(ratios) == 2 and all(r >= 1.0 for r in ratios)  # the whole call contains the integrator
+
+
+def test_moreau_jean_run_of_a_scene_does_not_import_scipy_integrate():
+    code = ("import sys, nonsmooth_rod as nr\n"
+            "from nonsmooth_rod import toys\n"
+            "toy = toys.BlockOnIncline(); q0, v0 = toy.initial_state()\n"
+            "run = nr.simulate(toy.scene(), q0, v0, 0.01, method='moreau-jean', h=1e-3)\n"
+            "assert run.status == 'ok', run.message\n"
+            "print(sorted(m for m in ('scipy.integrate', 'matplotlib', 'rich') if m in sys.modules))\n")
+    # interpreted: the imports are the same, and the subprocess does not compile the engine
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"), NONSMOOTH_ROD_NO_JIT="1")
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[-2] == "[]"
