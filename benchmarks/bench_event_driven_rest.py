@@ -28,7 +28,7 @@ from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_moreau_jean import yardstick_us  # noqa: E402
+from yardstick import yardstick_us  # noqa: E402
 
 WIDTH, HEIGHT, MASS = 0.2, 0.1, 1.0
 

@@ -8,28 +8,21 @@ one 3×3 numpy.linalg.solve in a plain Python loop. This machine is noisy: read 
 """
 from __future__ import annotations
 
+from pathlib import Path
+
+import sys
+
 import argparse
 import statistics
 import time
 
-import numpy as np
 
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.solvers import available_solvers
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
+from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
 
-
-def yardstick_us(n: int = 20000, repeats: int = 7) -> float:
-    rng = np.random.default_rng(0)
-    A = rng.standard_normal((3, 3)) + 3 * np.eye(3)
-    b = rng.standard_normal(3)
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(n):
-            np.linalg.solve(A, b)
-        times.append((time.perf_counter() - t0) / n * 1e6)
-    return statistics.median(times)
 
 
 def step_us(solver: str, h: float = 1e-4, repeats: int = 7, fast: bool = True) -> tuple[float, int, str]:

@@ -15,6 +15,8 @@ The cold compile time is a subprocess with an empty NUMBA_CACHE_DIR running one 
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import argparse
 import math
 import os
@@ -33,22 +35,13 @@ from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLi
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.rod.problem import RodProblem
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
+import other_engines  # noqa: E402  (benchmarks/other_engines.py)
+from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
 
 LEMKE_MAX_CONTACTS = 32
 BALL_RADIUS, BALL_MASS = 0.05, 0.1
 
-
-def yardstick_us(n: int = 20000, repeats: int = 5) -> float:
-    rng = np.random.default_rng(0)
-    A = rng.standard_normal((3, 3)) + 3 * np.eye(3)
-    b = rng.standard_normal(3)
-    times = []
-    for _ in range(repeats):
-        t0 = time.process_time()
-        for _ in range(n):
-            np.linalg.solve(A, b)
-        times.append((time.process_time() - t0) / n * 1e6)
-    return statistics.median(times)
 
 
 def ball_row(n: int):
@@ -110,6 +103,23 @@ def scenes(max_balls: int, quick: bool):
         yield "pile 8 rows", pile(8)
 
 
+def other_engines_us(name, scene, h, steps, repeats):
+    """(engine, µs per step) of MuJoCo and PyBullet on the same ball row or pile (when installed)."""
+    if name.startswith("ball row"):
+        centres = other_engines.row_positions(len(scene.bodies), BALL_RADIUS)
+    elif name.startswith("pile"):
+        centres = other_engines.pile_positions(int(name.split()[1]), BALL_RADIUS)
+    else:
+        return []
+    first = 1.0 if name.startswith("ball row") else 0.0
+    out = []
+    for engine, step in (("mujoco", other_engines.mujoco_step_us), ("bullet", other_engines.pybullet_step_us)):
+        cost = step(centres, BALL_RADIUS, BALL_MASS, h, steps, repeats, first_speed=first)
+        if cost is not None:
+            out.append((engine, cost))
+    return out
+
+
 def step_us(scene, q0, v0, solver, h, steps, repeats):
     options = MoreauJeanOptions(h=h, solver=solver)
     run = MoreauJean(options).run(scene, q0, v0, h * steps)  # warm-up: compiles on first use
@@ -121,33 +131,6 @@ def step_us(scene, q0, v0, solver, h, steps, repeats):
         run = MoreauJean(options).run(scene, q0, v0, h * steps)
         times.append((time.process_time() - t0) / run.steps * 1e6)
     return statistics.median(times), run
-
-
-def mujoco_step_us(scene_name, n, steps, repeats, h):
-    """mj_step per step on the same ball row / pile (spheres on a plane, planar not enforced)."""
-    try:
-        import mujoco
-    except ImportError:
-        return None
-    if scene_name.startswith("ball row"):
-        bodies = "".join(f'<body pos="{i * (2 * BALL_RADIUS + 1e-3)} 0 {BALL_RADIUS}"><freejoint/>'
-                         f'<geom type="sphere" size="{BALL_RADIUS}" mass="{BALL_MASS}"/></body>' for i in range(n))
-    else:
-        return None
-    xml = (f'<mujoco><option timestep="{h}"/><worldbody><geom type="plane" size="10 10 0.1"/>{bodies}'
-           '</worldbody></mujoco>')
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    data.qvel[0] = 1.0
-    times = []
-    for _ in range(repeats):
-        mujoco.mj_resetData(model, data)
-        data.qvel[0] = 1.0
-        t0 = time.process_time()
-        for _ in range(steps):
-            mujoco.mj_step(model, data)
-        times.append((time.process_time() - t0) / steps * 1e6)
-    return statistics.median(times)
 
 
 def cold_compile_seconds() -> float:
@@ -169,6 +152,26 @@ def cold_compile_seconds() -> float:
     return walls[0], walls[1]
 
 
+def plot_rows(rows_cost: dict, yard: float, path: str) -> None:
+    """Cost per step against the number of balls of a row, every engine, log–log, in yardsticks."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = {"lemke": "ours, lemke", "pgs": "ours, pgs", "mujoco": "MuJoCo mj_step", "bullet": "PyBullet stepSimulation"}
+    fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
+    for key, points in rows_cost.items():
+        n, us = zip(*points)
+        ax.loglog(n, [u / yard for u in us], "o-", label=labels.get(key, key))
+    ax.set(xlabel="balls in the row N (2N − 1 contacts)", ylabel="cost per step [× yardstick]",
+           title="a row of N balls on a floor, h = 1 ms")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="few steps, N = 2, 8, 32, one pile, 2 repeats")
@@ -176,7 +179,9 @@ def main(argv=None) -> int:
     parser.add_argument("--max-balls", type=int, default=None)
     parser.add_argument("--no-compile-time", action="store_true")
     parser.add_argument("--only", default="", help="run only the scenes whose name contains this")
+    parser.add_argument("--plot", default=None, metavar="PNG", help="log–log plot of cost per step against N (rows)")
     args = parser.parse_args(argv)
+    rows_cost = {}  # engine/solver → [(N balls, µs per step)] for the ball rows
     repeats = 2 if args.quick else args.repeats
     max_balls = args.max_balls or (32 if args.quick else 256)
     h, steps = 1e-3, (50 if args.quick else 500)
@@ -193,10 +198,14 @@ def main(argv=None) -> int:
             us, run = step_us(scene, q0, v0, solver, h, steps, repeats)
             note = "" if run.status == "ok" else f"  {run.status}: {run.message[:60]}"
             print(f"{name:28s} {nc:8d} {solver:>6s} {us:10.1f} {us / yard:11.2f}  {run.stats['compiled']}{note}")
-        if name.startswith("ball row"):
-            mj = mujoco_step_us(name, len(scene.bodies), steps, repeats, h)
-            if mj is not None:
-                print(f"{name:28s} {nc:8d} {'mujoco':>6s} {mj:10.1f} {mj / yard:11.2f}  mj_step")
+            if name.startswith("ball row"):
+                rows_cost.setdefault(solver, []).append((len(scene.bodies), us))
+        for engine, cost in other_engines_us(name, scene, h, steps, repeats):
+            print(f"{name:28s} {nc:8d} {engine:>6s} {cost:10.1f} {cost / yard:11.2f}  (its own step)")
+            if name.startswith("ball row"):
+                rows_cost.setdefault(engine, []).append((len(scene.bodies), cost))
+    if args.plot:
+        plot_rows(rows_cost, yard, args.plot)
     if not args.no_compile_time:
         cold, warm = cold_compile_seconds()
         print(f"first run, empty numba cache: {cold:.1f} s ({cold * 1e6 / yard:.2g} yardsticks); "

@@ -35,19 +35,9 @@ sys.path.insert(0, str(ROOT / "src"))
 from nonsmooth_rod.rod.problem import RodProblem  # noqa: E402
 from nonsmooth_rod.rod.regime import REFERENCE, SweepSettings, classify_point, warm_engine  # noqa: E402
 from nonsmooth_rod.rod.simulation import simulate  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
+from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
 
-
-def yardstick_us(n: int = 20000, repeats: int = 5) -> float:
-    rng = np.random.default_rng(0)
-    A = rng.standard_normal((3, 3)) + 3 * np.eye(3)
-    b = rng.standard_normal(3)
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(n):
-            np.linalg.solve(A, b)
-        times.append((time.perf_counter() - t0) / n * 1e6)
-    return statistics.median(times)
 
 
 def per_point_ms(settings: SweepSettings, n: int, repeats: int = 3) -> float:
