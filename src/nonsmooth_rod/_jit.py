@@ -78,16 +78,16 @@ COMPILE_ESTIMATE_S = 45  # benchmarks/bench_startup.py: 46.8 s cold (lemke, rod)
 _notifier = None
 
 
-def _marker() -> Path:
+def _marker(part: str = "engine") -> Path:
     from . import __version__
 
     base = os.environ.get("NUMBA_CACHE_DIR") or str(Path(__file__).resolve().parent / "__pycache__")
-    return Path(base) / f"nonsmooth-rod-{__version__}.compiled"
+    return Path(base) / f"nonsmooth-rod-{__version__}-{part}.compiled"
 
 
-def engine_is_warm() -> bool:
+def engine_is_warm(part: str = "engine") -> bool:
     """True when the engine's compiled kernels are (very likely) in the on-disk cache."""
-    return not ENABLED or _marker().exists()
+    return not ENABLED or _marker(part).exists()
 
 
 def set_compile_notifier(notify) -> None:
@@ -99,11 +99,12 @@ def set_compile_notifier(notify) -> None:
 class compiling_notice:
     """Context manager around a compiled run: says once that compiling happens, marks it done."""
 
-    def __init__(self, active: bool = True):
+    def __init__(self, active: bool = True, part: str = "engine"):
         self.active = active
+        self.part = part  # each solver's loop compiles on its first use: one marker each
 
     def __enter__(self):
-        self.cold = self.active and not engine_is_warm()
+        self.cold = self.active and not engine_is_warm(self.part)
         if self.cold:
             import logging
 
@@ -116,8 +117,8 @@ class compiling_notice:
     def __exit__(self, exc_type, exc, tb):
         if self.cold and exc_type is None:
             try:
-                _marker().parent.mkdir(parents=True, exist_ok=True)
-                _marker().touch()
+                _marker(self.part).parent.mkdir(parents=True, exist_ok=True)
+                _marker(self.part).touch()
             except OSError:
                 pass
         return False
