@@ -17,7 +17,6 @@ def register(subparsers) -> None:
 
 def warm_up() -> float:
     """Run one tiny scene per compiled solver and contact kind; returns the seconds it took."""
-    from .. import _jit
     from ..driver import simulate
     from ..model.body import RigidBody
     from ..model.contacts import DiskOnDisk, DiskOnLine, Line

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from .regime import GEOMETRY_AXES, KEY_DIGITS, OTHER_COLOUR, SCENARIO_COLOURS, row_key, Grid, InputError, RodProblem, SCENARIOS, SweepSettings, Thresholds, point_key, predicted_scenario, thresholds
+from .regime_grid import GEOMETRY_AXES, KEY_DIGITS, OTHER_COLOUR, SCENARIO_COLOURS, row_key, Grid, InputError, RodProblem, SCENARIOS, SweepSettings, Thresholds, point_key, predicted_scenario, thresholds
 
 
 def _edges(values: np.ndarray) -> np.ndarray:
