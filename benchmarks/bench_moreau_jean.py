@@ -8,21 +8,18 @@ one 3×3 numpy.linalg.solve in a plain Python loop. This machine is noisy: read 
 """
 from __future__ import annotations
 
-from pathlib import Path
-
-import sys
-
 import argparse
 import statistics
+import sys
 import time
-
+from pathlib import Path
 
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.solvers import available_solvers
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
 from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
-
 
 
 def step_us(solver: str, h: float = 1e-4, repeats: int = 7, fast: bool = True) -> tuple[float, int, str]:

@@ -15,8 +15,6 @@ The cold compile time is a subprocess with an empty NUMBA_CACHE_DIR running one 
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import argparse
 import math
 import os
@@ -25,6 +23,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -35,6 +34,7 @@ from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLi
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.rod.problem import RodProblem
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
 import other_engines  # noqa: E402  (benchmarks/other_engines.py)
 from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)

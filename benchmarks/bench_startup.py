@@ -18,8 +18,6 @@ the same run); medians of the repeats. --quick: one repeat, no cold compile, h =
 """
 from __future__ import annotations
 
-from pathlib import Path
-
 import argparse
 import os
 import statistics
@@ -27,6 +25,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
 from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)

@@ -33,11 +33,16 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 from nonsmooth_rod.rod.problem import RodProblem  # noqa: E402
-from nonsmooth_rod.rod.regime import REFERENCE, SweepSettings, classify_point, warm_engine  # noqa: E402
+from nonsmooth_rod.rod.regime import (  # noqa: E402
+    REFERENCE,
+    SweepSettings,
+    classify_point,
+    warm_engine,
+)
 from nonsmooth_rod.rod.simulation import simulate  # noqa: E402
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for the yardstick
 from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
-
 
 
 def per_point_ms(settings: SweepSettings, n: int, repeats: int = 3) -> float:
