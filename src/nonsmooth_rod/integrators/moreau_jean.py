@@ -171,11 +171,11 @@ class MoreauJean:
         p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
         if na > 0:
             W, q_step = np.zeros((2 * na, 2 * na)), np.empty(2 * na)
-            guess, mu_s, mu_d, closing = np.empty(na), np.empty(na), np.empty(na), np.empty(na)
-            kernels.assemble(params, na, q[k], v[k], model, work, W, q_step, guess, mu_s, mu_d, closing)
+            guess, mu_s, mu_d, closing, resting = (np.empty(na) for _ in range(5))
+            kernels.assemble(params, na, q[k], v[k], model, work, W, q_step, guess, mu_s, mu_d, closing, resting)
             try:
                 res = solve_two_coefficient(W, q_step, mu_s, mu_d, guess, self.options.solver,
-                                            self.options.solver_options, closing=closing)
+                                            self.options.solver_options, closing=closing, resting=resting)
             except SolverError as err:
                 self._solver_error = err
                 return loop.RUN_SOLVER_FAILED

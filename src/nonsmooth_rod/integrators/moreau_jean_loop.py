@@ -230,10 +230,12 @@ def delassus_blocks(na, model, work):
 
 
 @_inlined
-def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing):
-    """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd."""
+def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing, resting):
+    """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd;
+    `resting` is 1 for a contact loaded in the previous step or not slipping at the step's start."""
     minv, table, index = model[0], model[2], model[3]
     gaps, hn, ht, active, was_closed, slip_sign, v_free = work[0], work[2], work[3], work[4], work[5], work[7], work[8]
+    grazing = work[6]
     h = params[P_H]
     # A gap of a few ulps of the positions is no gap: closing it would ask a velocity round-off/h
     # that a body's other contacts cannot all follow (a statically indeterminate body would slip).
@@ -241,6 +243,10 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
     for d in range(vk.shape[0]):
         gap_roundoff = max(gap_roundoff, abs(qk[d]))
     gap_roundoff *= GAP_ROUNDOFF_ULPS * 2.220446049250313e-16
+    # A contact starts the step at rest when its slip velocity is round-off of the body speeds
+    rest_tol = 1e-12
+    for d in range(vk.shape[0]):
+        rest_tol = max(rest_tol, 1e-9 * abs(vk[d]))
     block = np.empty((2, 2))  # C-contiguous like delassus_blocks' blocks: _fill_block compiles once
     for a in range(na):
         i = active[a]
@@ -250,6 +256,11 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2] = block
         surface = table[i, C_SURFACE_VELOCITY]
         q_step[2 * a + 1] = local_dot(ht[i], index, i, v_free) - surface
+        # only a contact at rest — loaded in the previous step, or not slipping at the step's start —
+        # is held by a search over admissible splits (sticking.py); one grazing a rolling
+        # neighbour without load keeps the solver's answer (the search costs milliseconds there)
+        loaded = was_closed[i] and not grazing[i]
+        resting[a] = 1.0 if loaded or abs(local_dot(ht[i], index, i, vk) - surface) <= rest_tol else 0.0
         mu_s[a], mu_d[a] = table[i, C_MU_S], table[i, C_MU_D]
         if was_closed[i]:
             # A persistent contact may close an open gap, not only keep u_N ≥ 0: the Jacobian
@@ -392,8 +403,8 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
     sparse = solver_code == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
     W = np.zeros((0, 0)) if sparse else np.zeros((m, m))
     q_step = np.empty(m)
-    guess, mu_s, mu_d, closing = np.empty(na), np.empty(na), np.empty(na), np.empty(na)
-    assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing)
+    guess, mu_s, mu_d, closing, resting = np.empty(na), np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+    assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing, resting)
     if sparse:
         indptr, indices, blocks = delassus_blocks(na, model, work)
     else:
@@ -402,7 +413,7 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
     _warm_start(k, na, work, out, p)
     states = np.zeros(na, dtype=np.int64)
     status, solves, iterations, consistent = two_coefficient_kernel(
-        solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, params[P_RTOL],
+        solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL],
         iparams[I_MAX_ITER], p, u, states)
     counters = out[9]
     counters[K_SOLVES] += solves

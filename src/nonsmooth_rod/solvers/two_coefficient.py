@@ -189,13 +189,19 @@ def _guess_of_states(states, guess):
 
 
 @jit
-def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
+def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
+                 states):
     """Hold what μs can hold (sticking.prefer_sticking) when a contact that started the step at
-    rest does not stick; True when p, u, states were replaced. The common step returns at once."""
+    rest — slip velocity round-off at the step's start (`resting` 1), slip guess 0 — does not
+    stick; True when p, u, states were replaced. The common step returns at once. A contact
+    that was already sliding (or grazing a rolling neighbour) keeps the solver's answer: the
+    search costs milliseconds on rows of balls and has nothing to hold there."""
     na = mu_s.shape[0]
+    at_rest = np.empty(na)
     moving = False
     for i in range(na):
-        if start_guess[i] == 0.0 and states[i] != STATE_STICK:
+        at_rest[i] = start_guess[i] if resting[i] > 0.0 else 2.0  # 2: not a candidate
+        if at_rest[i] == 0.0 and states[i] != STATE_STICK:
             moving = True
     if not moving:
         return False
@@ -203,16 +209,17 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocit
         if na > MAX_DENSE_HOLD:
             return False
         W = _dense_of(indptr, indices, blocks, na)
-    return prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states)
+    return prefer_sticking(W, q, mu_s, mu_d, at_rest, velocity_tol, closing, p, u, states)
 
 
 @jit
-def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, rtol, max_iter,
-                           p, u, states):
+def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting, rtol,
+                           max_iter, p, u, states):
     """The exact two-coefficient law on u = W p + q, from slip guess `guess` (updated in place to
     the converged guess). W is dense (m × m), or empty with its block-sparse form (indptr,
     indices, blocks: solvers.kernels' layout) for pgs. p holds the warm start (pgs). `closing`
-    (per contact): the gap-closing part g/h of q_N, which a held body may leave open. Once the
+    (per contact): the gap-closing part g/h of q_N, which a held body may leave open; `resting`:
+    1 for a contact whose slip velocity at the step's start is round-off. Once the
     sign iteration is consistent, a contact that started at rest slides only if no admissible
     impulse split holds it (hold_at_rest).
     Returns (kernel status, solves, solver iterations, consistent)."""
@@ -249,7 +256,7 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
                 return status, n_tried, iterations, False
             classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess)
         break
-    if consistent and hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess,
+    if consistent and hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting,
                                    max(velocity_tol, 10.0 * residual), closing, p, u, states):
         _guess_of_states(states, guess)
     return KERNEL_SOLVED, n_tried, iterations, consistent
@@ -257,7 +264,8 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
 
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
                           slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
-                          max_solves: int = MAX_SOLVES, closing: np.ndarray | None = None) -> StepContactResult:
+                          max_solves: int = MAX_SOLVES, closing: np.ndarray | None = None,
+                          resting: np.ndarray | None = None) -> StepContactResult:
     """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`, with
     any solver of solvers.solve (the same rule as two_coefficient_kernel: classify_solution and
     next_action, hold_at_rest). `closing` (per contact, default 0): the gap-closing part g/h of
@@ -270,6 +278,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     start_guess = guess.copy()
     na = guess.shape[0]
     closing = np.zeros(na) if closing is None else np.ascontiguousarray(closing, dtype=float)
+    resting = np.ones(na) if resting is None else np.ascontiguousarray(resting, dtype=float)
     classify, action_of = interpreted(classify_solution), interpreted(next_action)
     lo, hi, new_guess, states = np.empty(na), np.empty(na), np.empty(na), np.zeros(na, dtype=np.int64)
     tried = np.empty((max_solves + 1, na))
@@ -297,7 +306,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         break
     p, u = np.array(sol.p, dtype=float), np.array(sol.u, dtype=float)
     empty = np.zeros(0, dtype=np.int64)
-    if consistent and hold_at_rest(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess,
+    if consistent and hold_at_rest(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess, resting,
                                    max(velocity_tol, 10.0 * sol.residual), closing, p, u, states):
         interpreted(_guess_of_states)(states, guess)
     return StepContactResult(p, u, [STATE_NAMES[s] for s in states], guess.copy(), n_tried, iterations,
