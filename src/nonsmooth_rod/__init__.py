@@ -14,6 +14,7 @@ __version__ = "0.2.0"
 from .driver import StopAtImpact, simulate
 from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLine
+from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce
 from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
 from .model.scene import Scene
 from .results import ContactState, Event, Impact, Phase, SimulationResult, Status, Trajectory
@@ -44,4 +45,5 @@ __all__ = [
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
     "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",
+    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce",
 ]
