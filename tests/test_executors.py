@@ -38,6 +38,19 @@ def _alive(pid: int) -> bool:
     return state != "Z"  # a zombie has exited; only its exit status waits to be collected
 
 
+def _kill_and_assert_none_survive(proc, pids, seconds: float) -> None:
+    """SIGKILL `proc`; none of `pids` may outlive it by more than `seconds`."""
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline and any(_alive(p) for p in pids):
+        time.sleep(0.1)
+    survivors = [p for p in pids if _alive(p)]
+    for p in survivors:  # clean up before failing
+        os.kill(p, signal.SIGKILL)
+    assert survivors == []
+
+
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
 def test_sigkill_of_a_sweep_leaves_no_worker():
     """The sweep's local executor (the one `sweep` opens) with both workers busy: SIGKILL the
@@ -55,15 +68,7 @@ def test_sigkill_of_a_sweep_leaves_no_worker():
     assert proc.stdout.readline().strip() == "busy", proc.stderr.read()[-2000:]
     workers = _children(proc.pid)
     assert len(workers) >= 2
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
-    deadline = time.monotonic() + 5
-    while time.monotonic() < deadline and any(_alive(p) for p in workers):
-        time.sleep(0.1)
-    survivors = [p for p in workers if _alive(p)]
-    for p in survivors:  # clean up before failing
-        os.kill(p, signal.SIGKILL)
-    assert survivors == []
+    _kill_and_assert_none_survive(proc, workers, seconds=5)
 
 
 def _descendants(pid: int) -> list[int]:
@@ -94,15 +99,7 @@ def test_sigkill_of_a_dask_sweep_leaves_no_worker_or_scheduler():
     assert proc.stdout.readline().strip() == "busy", proc.stderr.read()[-2000:]
     spawned = _descendants(proc.pid)
     assert len(spawned) >= 2  # the cluster's worker processes
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
-    deadline = time.monotonic() + 10
-    while time.monotonic() < deadline and any(_alive(p) for p in spawned):
-        time.sleep(0.2)
-    survivors = [p for p in spawned if _alive(p)]
-    for p in survivors:  # clean up before failing
-        os.kill(p, signal.SIGKILL)
-    assert survivors == []
+    _kill_and_assert_none_survive(proc, spawned, seconds=10)
 
 
 def test_dask_local_cluster_opens_and_closes():
