@@ -96,6 +96,14 @@ def Damper(body_a: int, point_a=(0.0, 0.0), body_b: int | None = None, point_b=(
     return Spring(body_a, point_a, body_b, point_b, stiffness=0.0, rest_length=0.0, damping=damping, name=name)
 
 
+def _check_force_at_point(force) -> None:
+    """The fields a constant and a ramped force share: body, force (fx, fy), point, torque."""
+    _require_body(force.name, "body", force.body)
+    object.__setattr__(force, "force", _require_point(force.name, "force", force.force))
+    object.__setattr__(force, "point", _require_point(force.name, "point", force.point))
+    require_finite(f"{force.name} torque", force.torque)
+
+
 @dataclass(frozen=True)
 class ConstantForce(_Force):
     """A constant world-frame force (and torque) at a body point."""
@@ -107,10 +115,7 @@ class ConstantForce(_Force):
     name: str = "force"
 
     def __post_init__(self):
-        _require_body(self.name, "body", self.body)
-        object.__setattr__(self, "force", _require_point(self.name, "force", self.force))
-        object.__setattr__(self, "point", _require_point(self.name, "point", self.point))
-        require_finite(f"{self.name} torque", self.torque)
+        _check_force_at_point(self)
 
 
 @dataclass(frozen=True)
@@ -126,10 +131,7 @@ class RampedForce(_Force):
     name: str = "ramp"
 
     def __post_init__(self):
-        _require_body(self.name, "body", self.body)
-        object.__setattr__(self, "force", _require_point(self.name, "force", self.force))
-        object.__setattr__(self, "point", _require_point(self.name, "point", self.point))
-        require_finite(f"{self.name} torque", self.torque)
+        _check_force_at_point(self)
         require_finite(f"{self.name} t_start", self.t_start)
         require_finite(f"{self.name} t_full", self.t_full)
         if not self.t_full > self.t_start:
