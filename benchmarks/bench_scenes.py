@@ -28,9 +28,10 @@ from pathlib import Path
 import numpy as np
 
 from nonsmooth_rod import toys
+from nonsmooth_rod.toys import stacks
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.model.body import RigidBody
-from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, Line, PointOnLine
+from nonsmooth_rod.model.contacts import Line, PointOnLine
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.rod.problem import RodProblem
@@ -40,41 +41,7 @@ import other_engines  # noqa: E402  (benchmarks/other_engines.py)
 from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
 
 LEMKE_MAX_CONTACTS = 32
-BALL_RADIUS, BALL_MASS = 0.05, 0.1
-
-
-
-def ball_row(n: int):
-    """N balls on a floor, 1 mm apart, the first rolling at 1 m/s into the others."""
-    law = ContactLaw.of(0.3, 0.2, 0.0)
-    bodies = [RigidBody(BALL_MASS, 0.4 * BALL_MASS * BALL_RADIUS**2, f"ball{i}") for i in range(n)]
-    contacts = [DiskOnLine(i, (0.0, 0.0), Line(), BALL_RADIUS, law, f"floor{i}") for i in range(n)]
-    contacts += [DiskOnDisk(i + 1, i, BALL_RADIUS, BALL_RADIUS, law=law, name=f"{i}-{i + 1}") for i in range(n - 1)]
-    q0 = np.zeros(3 * n)
-    q0[0::3] = np.arange(n) * (2 * BALL_RADIUS + 1e-3)
-    q0[1::3] = BALL_RADIUS
-    v0 = np.zeros(3 * n)
-    v0[0], v0[2] = 1.0, -1.0 / BALL_RADIUS
-    return Scene(bodies, contacts), q0, v0
-
-
-def pile(rows: int):
-    """A pyramid of disks resting on a floor: each disk on the two below it."""
-    law = ContactLaw.of(0.5, 0.4, 0.0)
-    centres, index = [], {}
-    for r in range(rows):
-        for c in range(rows - r):
-            index[r, c] = len(centres)
-            centres.append(((2 * c + r) * BALL_RADIUS, BALL_RADIUS * (1 + r * math.sqrt(3))))
-    bodies = [RigidBody(BALL_MASS, 0.4 * BALL_MASS * BALL_RADIUS**2, f"disk{i}") for i in range(len(centres))]
-    contacts = [DiskOnLine(index[0, c], (0.0, 0.0), Line(), BALL_RADIUS, law, f"floor{c}") for c in range(rows)]
-    for (r, c), i in index.items():
-        if r > 0:
-            contacts += [DiskOnDisk(i, index[r - 1, c + k], BALL_RADIUS, BALL_RADIUS, law=law, name=f"{i}/{k}")
-                         for k in (0, 1)]
-    q0 = np.zeros(3 * len(centres))
-    q0[0::3], q0[1::3] = zip(*centres)
-    return Scene(bodies, contacts), q0, np.zeros_like(q0)
+ball_row, pile = stacks.ball_row, stacks.disk_pile  # the same scenes the tests run
 
 
 def ladder():
@@ -105,16 +72,15 @@ def scenes(max_balls: int, quick: bool):
 
 def other_engines_us(name, scene, h, steps, repeats):
     """(engine, µs per step) of MuJoCo and PyBullet on the same ball row or pile (when installed)."""
-    if name.startswith("ball row"):
-        centres = other_engines.row_positions(len(scene.bodies), BALL_RADIUS)
-    elif name.startswith("pile"):
-        centres = other_engines.pile_positions(int(name.split()[1]), BALL_RADIUS)
-    else:
+    if not name.startswith(("ball row", "pile")):
         return []
+    q0 = stacks.ball_row(len(scene.bodies))[1] if name.startswith("ball row") else stacks.disk_pile(
+        int(name.split()[1]))[1]
+    centres = list(zip(q0[0::3].tolist(), q0[1::3].tolist()))
     first = 1.0 if name.startswith("ball row") else 0.0
     out = []
     for engine, step in (("mujoco", other_engines.mujoco_step_us), ("bullet", other_engines.pybullet_step_us)):
-        cost = step(centres, BALL_RADIUS, BALL_MASS, h, steps, repeats, first_speed=first)
+        cost = step(centres, stacks.BALL_RADIUS, stacks.BALL_MASS, h, steps, repeats, first_speed=first)
         if cost is not None:
             out.append((engine, cost))
     return out

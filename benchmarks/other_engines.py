@@ -12,22 +12,6 @@ from __future__ import annotations
 import statistics
 import time
 
-GAP = 1e-3
-
-
-def row_positions(n: int, radius: float) -> list[tuple[float, float]]:
-    """(x, height) of the ball centres of a row."""
-    return [(i * (2 * radius + GAP), radius) for i in range(n)]
-
-
-def pile_positions(rows: int, radius: float) -> list[tuple[float, float]]:
-    """(x, height) of the ball centres of a triangular pile, `rows` balls at the bottom."""
-    out = []
-    for level in range(rows):
-        for i in range(rows - level):
-            out.append(((i + 0.5 * level) * 2 * radius, radius * (1 + level * 3**0.5)))
-    return out
-
 
 def _median_step_us(step, reset, steps: int, repeats: int) -> float:
     times = []

@@ -584,7 +584,7 @@ class EventDriven:
         """A body at rest (v = 0 within velocity_tol, a = 0 to round-off) in stick or flight under
         constant forces stays at rest, and no indicator can move: hold the state to t_end in one
         go instead of integrating nothing. An applied force may change in time: then integrate."""
-        if scene.applied_force is not None or any(m not in ("stick", "open") for m in modes):
+        if scene.forces_vary_in_time() or any(m not in ("stick", "open") for m in modes):
             return False
         if np.max(np.abs(run.v), initial=0.0) > self.options.velocity_tol:
             return False

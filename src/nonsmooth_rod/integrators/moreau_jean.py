@@ -249,7 +249,8 @@ class MoreauJean:
         events = sorted(events + phase_events, key=lambda e: e.t) + ([failure] if failure else [])
         stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
                      solver_iterations=int(counters[loop.K_ITERATIONS]),
-                     inconsistent_steps=int(counters[loop.K_INCONSISTENT]))
+                     inconsistent_steps=int(counters[loop.K_INCONSISTENT]),
+                     solver_fallbacks=int(counters[loop.K_FALLBACKS]))
         traj = Trajectory(t, q, v, a, N, T, modes)
         return SimulationResult(self.name, status, message, traj, names, events, impacts, phases,
                                 steps=n_done, cpu_time_s=cpu, stats=stats)

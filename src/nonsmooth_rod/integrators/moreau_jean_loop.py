@@ -56,8 +56,8 @@ IMPACT_VELOCITY_TOL = 1e-9
 RUN_OK, RUN_SOLVER_FAILED, RUN_NONFINITE, RUN_STOPPED, RUN_BAD_GEOMETRY = 0, 1, 2, 3, 4
 # Slots of the int64 `counters` record.
 (K_DONE, K_STATUS, K_FAIL_STEP, K_N_IMPACTS, K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_SOLVER_STATUS,
- K_FAIL_CONTACT) = range(9)
-N_COUNTERS = 9
+ K_FAIL_CONTACT, K_FALLBACKS) = range(10)
+N_COUNTERS = 10
 # Float parameters: h, θ, γ (activation), t0, solver rtol. Int parameters: solver code, max
 # iterations, stop contact (−1: none).
 P_H, P_THETA, P_GAMMA, P_T0, P_RTOL = range(5)
@@ -412,12 +412,13 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
     p, u = np.zeros(m), np.zeros(m)
     _warm_start(k, na, work, out, p)
     states = np.zeros(na, dtype=np.int64)
-    status, solves, iterations, consistent = two_coefficient_kernel(
+    status, solves, iterations, consistent, fallbacks = two_coefficient_kernel(
         solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL],
         iparams[I_MAX_ITER], p, u, states)
     counters = out[9]
     counters[K_SOLVES] += solves
     counters[K_ITERATIONS] += iterations
+    counters[K_FALLBACKS] += fallbacks
     if status == KERNEL_SOLVED and not consistent:
         counters[K_INCONSISTENT] += 1
     return status, p, u, states

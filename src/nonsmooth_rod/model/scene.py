@@ -73,6 +73,14 @@ class Scene:
                     raise InputError(f"forces[{i}] ({force.name!r}) {attr} refers to body {body}, but the scene "
                                      f"has {len(self.bodies)} bodies")
 
+    def forces_vary_in_time(self) -> bool:
+        """True when the applied force may change while the state does not (a Python
+        `applied_force`, a RampedForce or a TabulatedForce): a body at rest need not stay so."""
+        from .forces import RampedForce, TabulatedForce
+
+        return self.applied_force is not None or any(isinstance(f, (RampedForce, TabulatedForce))
+                                                     for f in self.forces)
+
     @property
     def n_dof(self) -> int:
         return 3 * len(self.bodies)

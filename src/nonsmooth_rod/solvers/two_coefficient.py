@@ -28,8 +28,8 @@ from .. import _jit
 from .._jit import jit
 # The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
 # Python (solve_two_coefficient below).
-from .kernels import (KERNEL_SOLVED, SOLVER_CODES, SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, pgs_block, solve_enum,
-                      solve_interval, solve_lemke, solve_pgs)
+from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS,
+                      lemke_interval, pgs_block, solve_enum, solve_interval, solve_lemke, solve_pgs)
 from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
 from .sticking import prefer_sticking
@@ -131,39 +131,6 @@ def _interval_of(mu_s, mu_d, guess, lo, hi):
         hi[j] = shift + mu_s[j]
 
 
-def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval on the dense W, or pgs_block when the block-sparse W is given (indptr).
-
-    Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
-    that solver (`_solve_compiled`); lemke and enum then take the dense W."""
-    if indptr.shape[0] > 0:
-        return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
-    return solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
-
-
-_solve.py_func = _solve  # so solvers._common.interpreted rebinds the kernels it calls
-
-if _jit.ENABLED:
-    from numba.extending import overload
-
-    @overload(_solve, prefer_literal=True)
-    def _solve_compiled(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-        """_solve for numba: one solver for a literal solver code (a cold compile then skips the
-        others: issue 16), the run-time dispatch otherwise."""
-        dense = {SOLVER_LEMKE: solve_lemke, SOLVER_ENUM: solve_enum}.get(getattr(solver_code, "literal_value", None))
-        if dense is not None:
-            def solve_dense(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-                return dense(W, q, lo, hi, p, u, rtol, max_iter)
-            return solve_dense
-        if getattr(solver_code, "literal_value", None) == SOLVER_PGS:
-            def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-                if indptr.shape[0] > 0:
-                    return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
-                return solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
-            return solve_pgs_either
-        return _solve
-
-
 # Statically indeterminate holds are searched on a dense W; pgs scenes larger than this (piles,
 # rows of hundreds of balls) keep the solver's split rather than densify every such step.
 MAX_DENSE_HOLD = 64
@@ -180,6 +147,58 @@ def _dense_of(indptr, indices, blocks, na):
                 for b in range(2):
                     W[2 * i + a, 2 * j + b] = blocks[k, a, b]
     return W
+
+
+@jit
+def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+    """pgs on the block-sparse W; a step it cannot solve with at most MAX_DENSE_HOLD contacts is
+    solved again by Lemke on the dense W. Gauss–Seidel can stall on a singular W (a pile: many
+    coupled contacts, q a little outside W's range) just above its acceptance, where Lemke's
+    pivoting is exact. Returns (status, sweeps + pivots, residual, 1 if it fell back else 0)."""
+    status, sweeps, residual = pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+    na = lo.shape[0]
+    if status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
+        return status, sweeps, residual, 0
+    W = _dense_of(indptr, indices, blocks, na)
+    status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0)  # Lemke's own acceptance
+    return status, sweeps + pivots, residual, 1
+
+
+def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval on the dense W, or pgs_or_lemke when the block-sparse W is given (indptr).
+    Returns (status, iterations, residual, 1 if pgs fell back to Lemke else 0).
+
+    Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
+    that solver (`_solve_compiled`); lemke and enum then take the dense W."""
+    if indptr.shape[0] > 0:
+        return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+    status, iterations, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+    return status, iterations, residual, 0
+
+
+_solve.py_func = _solve  # so solvers._common.interpreted rebinds the kernels it calls
+
+if _jit.ENABLED:
+    from numba.extending import overload
+
+    @overload(_solve, prefer_literal=True)
+    def _solve_compiled(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+        """_solve for numba: one solver for a literal solver code (a cold compile then skips the
+        others: issue 16), the run-time dispatch otherwise."""
+        dense = {SOLVER_LEMKE: solve_lemke, SOLVER_ENUM: solve_enum}.get(getattr(solver_code, "literal_value", None))
+        if dense is not None:
+            def solve_dense(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+                status, iterations, residual = dense(W, q, lo, hi, p, u, rtol, max_iter)
+                return status, iterations, residual, 0
+            return solve_dense
+        if getattr(solver_code, "literal_value", None) == SOLVER_PGS:
+            def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+                if indptr.shape[0] > 0:
+                    return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+                status, iterations, residual = solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
+                return status, iterations, residual, 0
+            return solve_pgs_either
+        return _solve
 
 
 @jit
@@ -222,7 +241,7 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
     1 for a contact whose slip velocity at the step's start is round-off. Once the
     sign iteration is consistent, a contact that started at rest slides only if no admissible
     impulse split holds it (hold_at_rest).
-    Returns (kernel status, solves, solver iterations, consistent)."""
+    Returns (kernel status, solves, solver iterations, consistent, pgs steps solved again by Lemke)."""
     na = guess.shape[0]
     start_guess = guess.copy()
     lo, hi, new_guess = np.empty(na), np.empty(na), np.empty(na)
@@ -231,35 +250,31 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
     for r in range(2 * na):
         scale_v = max(scale_v, abs(q[r]))
     velocity_tol = 1e-9 * scale_v
-    n_tried, iterations, consistent = 0, 0, False
+    n_tried, iterations, fallbacks, consistent, last = 0, 0, 0, False, False
     while True:
         tried[n_tried] = guess
         n_tried += 1
         _interval_of(mu_s, mu_d, guess, lo, hi)
-        status, its, residual = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+        status, its, residual, fell_back = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol,
+                                                  max_iter)
         iterations += its
+        fallbacks += fell_back
         if status != KERNEL_SOLVED:
-            return status, n_tried, iterations, False
-        if classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
+            return status, n_tried, iterations, False, fallbacks
+        if classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess) and not last:
             consistent = True
+            break
+        if last:  # the ordinary μs problem after a cycle: exact for sticking, counted inconsistent
             break
         action = next_action(new_guess, tried, n_tried)
         guess[:] = new_guess
-        if action == NEXT_RETRY:
-            continue
-        if action == NEXT_TRY_ZERO:
-            _interval_of(mu_s, mu_d, guess, lo, hi)
-            status, its, residual = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
-            iterations += its
-            n_tried += 1
-            if status != KERNEL_SOLVED:
-                return status, n_tried, iterations, False
-            classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess)
-        break
+        if action == NEXT_STOP:
+            break
+        last = action == NEXT_TRY_ZERO
     if consistent and hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting,
                                    max(velocity_tol, 10.0 * residual), closing, p, u, states):
         _guess_of_states(states, guess)
-    return KERNEL_SOLVED, n_tried, iterations, consistent
+    return KERNEL_SOLVED, n_tried, iterations, consistent, fallbacks
 
 
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
@@ -283,27 +298,23 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     lo, hi, new_guess, states = np.empty(na), np.empty(na), np.empty(na), np.zeros(na, dtype=np.int64)
     tried = np.empty((max_solves + 1, na))
     velocity_tol = 1e-9 * max(1e-12, float(np.max(np.abs(q), initial=0.0)))
-    n_tried, iterations, consistent = 0, 0, False
+    n_tried, iterations, consistent, last = 0, 0, False, False
     while True:
         tried[n_tried] = guess
         n_tried += 1
         interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
         sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
         iterations += sol.iterations
-        if classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess):
+        if classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess) and not last:
             consistent = True
+            break
+        if last:  # the ordinary μs problem after a cycle: exact for sticking, counted inconsistent
             break
         action = action_of(new_guess, tried, n_tried)
         guess[:] = new_guess
-        if action == NEXT_RETRY:
-            continue
-        if action == NEXT_TRY_ZERO:
-            interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
-            sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
-            iterations += sol.iterations
-            n_tried += 1
-            classify(sol.p, sol.u, sol.residual, mu_s, guess, velocity_tol, states, new_guess)
-        break
+        if action == NEXT_STOP:
+            break
+        last = action == NEXT_TRY_ZERO
     p, u = np.array(sol.p, dtype=float), np.array(sol.u, dtype=float)
     empty = np.zeros(0, dtype=np.int64)
     if consistent and hold_at_rest(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess, resting,

@@ -7,10 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.contacts import Line
+from ..model.forces import Spring
 from ..model.scene import Scene
 from ..results import SimulationResult
 from ..validation import InputError, require_friction_pair, require_positive
-from .common import G, _block_scene, _force_along_floor
+from .common import G, _block_scene
 
 
 @dataclass(frozen=True)
@@ -22,7 +23,8 @@ class BeltOscillator:
     reaches μs N (x = μs N/k), then slips with friction μd N, oscillating about x_d = μd N/k
     until its velocity matches the belt again at x = x_d − y0, y0 = (μs − μd) N/k, and sticks:
     stick time 2 y0 / v_b, slip time (2π − 2 atan(ω y0 / v_b)) / ω, ω = √(k/m).
-    The spring acts along the belt's surface (see PushedBlock: no pitching, equal corner loads).
+    The spring acts along the belt's surface (see PushedBlock: no pitching, equal corner loads);
+    it is a `Spring` (data), so the whole run is one compiled call.
     """
 
     belt_speed: float = 0.1
@@ -46,7 +48,10 @@ class BeltOscillator:
         return Line((0.0, 0.0), 0.0, self.belt_speed)
 
     def scene(self) -> Scene:
-        return _block_scene(self, _force_along_floor(self.height, lambda t, q: -self.stiffness * q[0]))
+        # a zero-length spring from the middle of the block's bottom face to the anchor at the
+        # origin of the belt's surface: −k x along the belt while the block lies flat on it
+        spring = Spring(0, (0.0, -self.height / 2), None, (0.0, 0.0), stiffness=self.stiffness, name="spring")
+        return _block_scene(self, [spring])
 
     def initial_state(self):
         return np.array([0.0, self.height / 2, 0.0]), np.array([self.belt_speed, 0.0, 0.0])

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
-from ..model.body import RigidBody, cross2, rotate
+from ..model.body import RigidBody
 from ..model.contacts import Line, PointOnLine
 from ..model.laws import ContactLaw
 from ..model.scene import Scene
@@ -43,25 +43,13 @@ def _corners(body: int, width: float, height: float, line: Line, law: ContactLaw
             PointOnLine(body, (a, -b), line, law, name="right")]
 
 
-def _block_scene(toy, applied_force=None) -> Scene:
-    """A toy's width × height block on its `line`, both bottom corners with its μs/μd, e = 0."""
+def _block_scene(toy, forces=()) -> Scene:
+    """A toy's width × height block on its `line`, both bottom corners with its μs/μd, e = 0, and
+    `forces` (model.forces: data the compiled loop evaluates, no Python callback)."""
     body = RigidBody(toy.mass, _rectangle_inertia(toy.mass, toy.width, toy.height), name="block")
     law = ContactLaw.of(toy.mu_s, toy.mu_d, 0.0)
     return Scene([body], _corners(0, toy.width, toy.height, toy.line, law), gravity=toy.g,
-                 applied_force=applied_force)
-
-
-def _force_along_floor(height: float, magnitude):
-    """Applied force `magnitude(t, q)` along +x acting at the block's bottom face (the floor
-    line), so it neither pitches the block nor unloads one corner."""
-    b = height / 2
-
-    def applied(t, q, v):
-        force = (magnitude(t, q), 0.0)
-        lever = rotate(q[2], (0.0, -b))  # from the centre of mass to the floor line
-        return np.array([force[0], force[1], cross2(lever, force)])
-
-    return applied
+                 forces=forces)
 
 
 def _slope_coordinate(result: SimulationResult, angle: float, body: int = 0) -> tuple[np.ndarray, np.ndarray]:

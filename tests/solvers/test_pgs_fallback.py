@@ -1,0 +1,73 @@
+"""A pgs step that Gauss–Seidel cannot finish is solved again by Lemke on the dense W.
+
+Gauss–Seidel drifts along the null space of a singular W and can stall just above its
+acceptance (a pile of disks: tens of coupled, statically indeterminate contacts). Such a step,
+with at most MAX_DENSE_HOLD contacts, is handed to Lemke; the run counts it in
+stats["solver_fallbacks"] and goes on.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+from nonsmooth_rod.solvers.gauss_seidel import dense_to_blocks
+from nonsmooth_rod.solvers.kernels import KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, pgs_block
+from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity_residual, residual_scale
+from nonsmooth_rod.solvers.two_coefficient import pgs_or_lemke
+from nonsmooth_rod.toys.stacks import disk_pile
+from solver_cases import block_on_incline
+
+
+def test_a_step_one_sweep_leaves_unsolved_is_solved_by_the_fallback():
+    problem = block_on_incline(0.3, 0.5)  # two corners: W of rank 3
+    indptr, indices, blocks = dense_to_blocks(problem.W)
+    p, u = np.zeros(4), problem.q.copy()
+    assert pgs_block(indptr, indices, blocks, problem.q, problem.lo, problem.hi, p, u, 0.0, 1)[0] \
+        == KERNEL_NO_CONVERGENCE
+    p, u = np.zeros(4), problem.q.copy()
+    status, iterations, residual, fell_back = pgs_or_lemke(indptr, indices, blocks, problem.q, problem.lo,
+                                                           problem.hi, p, u, 0.0, 1)
+    assert (status, fell_back) == (KERNEL_SOLVED, 1)
+    assert iterations > 1  # the sweep and Lemke's pivots
+    scale = residual_scale(problem, p, u)
+    assert complementarity_residual(problem, p) <= 1e-12 * scale
+    np.testing.assert_allclose(u, problem.W @ p + problem.q, rtol=0, atol=1e-13 * scale)
+
+
+def test_a_converged_pgs_step_does_not_fall_back():
+    problem = block_on_incline(0.3, 0.5)
+    indptr, indices, blocks = dense_to_blocks(problem.W)
+    p, u = np.zeros(4), problem.q.copy()
+    status, _, _, fell_back = pgs_or_lemke(indptr, indices, blocks, problem.q, problem.lo, problem.hi, p, u, 0.0, 0)
+    assert (status, fell_back) == (KERNEL_SOLVED, 0)
+
+
+@pytest.fixture(scope="module")
+def pile_run():
+    scene, q0, v0 = disk_pile(6)  # 21 disks, 36 contacts, one coupled group
+    run = MoreauJean(MoreauJeanOptions(h=1e-3, solver="pgs")).run(scene, q0, v0, 0.25)
+    return scene, run
+
+
+def test_the_pile_runs_with_pgs_through_its_stalled_steps(pile_run):
+    scene, run = pile_run
+    assert run.status == "ok", run.message
+    assert run.stats["compiled"] and run.stats["solver_fallbacks"] >= 1
+    assert run.t[-1] == pytest.approx(0.25, rel=1e-12)
+
+
+def test_the_pile_obeys_the_law_and_never_gains_energy(pile_run):
+    scene, run = pile_run
+    traj = run.trajectory
+    N, T = traj.normal_force[1:], traj.tangential_force[1:]
+    scale = np.max(N)
+    assert np.all(N >= 0.0)
+    mu_s = np.array([c.law.friction.mu_s for c in scene.contacts])
+    assert np.all(np.abs(T) <= mu_s * N + 1e-9 * scale)
+    energy = np.array([scene.kinetic_energy(v) + scene.bodies[0].mass * scene.gravity * np.sum(q[1::3])
+                       for q, v in zip(traj.q, traj.v)])  # equal masses
+    # θ = ½, e = 0: Moreau–Jean dissipates; round-off of the energy's scale allowed
+    assert np.all(np.diff(energy) <= 1e-12 * np.max(np.abs(energy)))
+    radius = scene.contacts[0].radius
+    assert np.min(traj.q[:, 1::3]) >= radius - 1e-6 * radius  # no disk through the floor
