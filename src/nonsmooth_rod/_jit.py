@@ -64,10 +64,103 @@ def jit(function):
         return function
     import numba
 
+    if not _purged:
+        purge_stale_kernels()
     return numba.njit(cache=True)(function)
 
 
-__all__ = ["jit", "ENABLED"]
+# ---------------------------------------------------------------- stale cached kernels
+# numba recompiles a cached kernel when its own source file changes, not when a kernel it calls
+# (and compiled into itself) changes: after an edit of solvers/lemke.py the Moreau–Jean loop
+# would go on running the old Lemke from the cache. A digest of the package's sources, kept
+# next to the cache, drops every cached kernel of the package when any source changed.
+_purged = False
+
+
+def _package_sources() -> list[Path]:
+    return sorted(Path(__file__).resolve().parent.rglob("*.py"))
+
+
+def _cache_dir_of(source: Path) -> Path:
+    """Where numba caches the kernels of `source` (its in-tree or user-provided locator)."""
+    from numba.core import caching, config
+
+    if config.CACHE_DIR:
+        return Path(config.CACHE_DIR) / caching._CacheLocator.get_suitable_cache_subpath(str(source))
+    return source.parent / "__pycache__"
+
+
+def sources_digest() -> str:
+    import hashlib
+
+    digest = hashlib.blake2b(digest_size=16)
+    for source in _package_sources():
+        digest.update(source.name.encode())
+        digest.update(source.read_bytes())
+    return digest.hexdigest()
+
+
+def purge_stale_kernels() -> bool:
+    """Drop the package's cached kernels and compile markers when its sources changed since they
+    were cached; True when it purged. Costs ~1 ms (hashing the sources) once per process."""
+    global _purged
+    _purged = True
+    stamp = _marker("sources").with_suffix(".digest")
+    current = sources_digest()
+    try:
+        if stamp.read_text() == current:
+            return False
+    except OSError:
+        pass
+    for source in _package_sources():
+        folder = _cache_dir_of(source)
+        for cached in list(folder.glob(f"{source.stem}.*.nbi")) + list(folder.glob(f"{source.stem}.*.nbc")):
+            cached.unlink(missing_ok=True)
+    for marker in stamp.parent.glob("nonsmooth-rod-*.compiled"):
+        marker.unlink(missing_ok=True)
+    try:
+        stamp.parent.mkdir(parents=True, exist_ok=True)
+        stamp.write_text(current)
+    except OSError:
+        pass  # a read-only cache: numba cannot write there either
+    return True
+
+
+__all__ = ["jit", "ENABLED", "one_blas_thread"]
+
+
+# ---------------------------------------------------------------- BLAS threads
+# The hold search (solvers/sticking.py) calls LAPACK (an SVD) on matrices of a few rows. With
+# OpenBLAS's thread pool each such call wakes its threads, which then spin after it: on the
+# 2-core machine that doubled the search's cost and slowed whatever ran next (MuJoCo's N = 16
+# row measured twice its cost after one of our runs). A Moreau–Jean run therefore keeps BLAS on
+# one thread (threadpoolctl, in the `fast` extra; without it this does nothing).
+_blas = None
+
+
+class one_blas_thread:
+    """Context manager: BLAS/LAPACK (numpy's and scipy's OpenBLAS, which numba's kernels call) on
+    one thread inside, the previous limits restored after. ~30 µs to enter once warm."""
+
+    def __enter__(self):
+        global _blas
+        self._limit = None
+        if _blas is None:
+            try:
+                import scipy.linalg.cython_lapack  # noqa: F401  (the LAPACK numba's kernels call)
+                from threadpoolctl import ThreadpoolController
+            except ImportError:
+                _blas = False
+                return self
+            _blas = ThreadpoolController()
+        if _blas:
+            self._limit = _blas.limit(limits=1, user_api="blas")
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if self._limit is not None:
+            self._limit.restore_original_limits()
+        return False
 
 
 # ---------------------------------------------------------------- saying when we compile

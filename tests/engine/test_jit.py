@@ -25,3 +25,62 @@ def test_a_writable_package_folder_keeps_numbas_default(monkeypatch):
     monkeypatch.setattr(_jit.os, "access", lambda path, mode: True)
     _jit._choose_cache_dir()
     assert "NUMBA_CACHE_DIR" not in os.environ
+
+
+# ------------------------------------------------------------ stale cached kernels
+def test_changed_sources_drop_the_packages_cached_kernels_and_compile_markers(monkeypatch, tmp_path):
+    source, cache = tmp_path / "src" / "loop.py", tmp_path / "cache"
+    source.parent.mkdir()
+    cache.mkdir()
+    source.write_text("x = 1\n")
+    monkeypatch.setattr(_jit, "_package_sources", lambda: [source])
+    monkeypatch.setattr(_jit, "_cache_dir_of", lambda path: cache)
+    monkeypatch.setattr(_jit, "_marker", lambda part="engine": cache / f"nonsmooth-rod-9.9-{part}.compiled")
+
+    def cached_files():
+        for name in ("loop.run-10.py311.nbi", "loop.run-10.py311.1.nbc", "other.run-3.py311.nbi"):
+            (cache / name).write_text("")
+        (cache / "nonsmooth-rod-9.9-lemke.compiled").touch()
+
+    cached_files()
+    assert _jit.purge_stale_kernels()  # no digest yet: whatever is cached may be stale
+    assert sorted(p.name for p in cache.iterdir()) == ["nonsmooth-rod-9.9-sources.digest", "other.run-3.py311.nbi"]
+    cached_files()
+    assert not _jit.purge_stale_kernels()  # the same sources: the cache stays
+    assert (cache / "loop.run-10.py311.nbi").exists() and (cache / "nonsmooth-rod-9.9-lemke.compiled").exists()
+    source.write_text("x = 2\n")  # a kernel's source changed: its callers' cached code is stale
+    assert _jit.purge_stale_kernels()
+    assert not (cache / "loop.run-10.py311.nbi").exists() and not (cache / "loop.run-10.py311.1.nbc").exists()
+    assert not (cache / "nonsmooth-rod-9.9-lemke.compiled").exists()
+
+
+def test_the_purged_folders_are_where_numba_caches_the_kernels():
+    import pytest
+    from pathlib import Path
+
+    if not _jit.ENABLED:
+        pytest.skip("numba not installed or disabled")
+    from nonsmooth_rod.integrators import moreau_jean_loop
+    from nonsmooth_rod.solvers import lemke
+
+    for module, kernel in ((moreau_jean_loop, moreau_jean_loop.run_steps_lemke), (lemke, lemke._lemke_friction_kernel)):
+        assert Path(kernel._cache._cache_path) == _jit._cache_dir_of(Path(module.__file__))
+
+
+# ------------------------------------------------------------ BLAS threads
+def test_blas_runs_on_one_thread_inside_a_run_and_its_limits_come_back_after():
+    import pytest
+
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    import numpy  # noqa: F401
+
+    with _jit.one_blas_thread():
+        inside = [lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"]
+    after = [lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"]
+    assert inside and set(inside) == {1}
+    with threadpoolctl.threadpool_limits(2, "blas"):
+        before = [lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"]
+        with _jit.one_blas_thread():
+            pass
+        assert [lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"] == before
+    assert len(after) == len(inside)

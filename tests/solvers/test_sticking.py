@@ -152,3 +152,66 @@ def test_a_held_body_leaves_a_round_off_gap_open(told):
         assert list(states) == [STATE_STICK, STATE_STICK]
         # H_N v = 0 on both, to round-off of the step's velocities
         assert u[0] == pytest.approx(closing[0], rel=1e-6) and abs(u[2]) < 500 * np.finfo(float).eps * np.max(np.abs(q))
+
+
+# ------------------------------------------------------------ groups of coupled contacts
+def _two_wedged_rods():
+    """The step of two wedged rods in one problem (block-diagonal W): the first holdable
+    (μs > tan φ), the second not; both start falling freely."""
+    held, falls = WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5), \
+        WedgedRod(angle=math.radians(30.0), mu_s=0.5, mu_d=0.4)
+    (W1, q1), (W2, q2) = _step_problem(held), _step_problem(falls)
+    W = np.zeros((8, 8))
+    W[:4, :4], W[4:, 4:] = W1, W2
+    return W, np.r_[q1, q2], np.array([0.7, 0.7, 0.5, 0.5]), np.array([0.5, 0.5, 0.4, 0.4]), (W1, q1)
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_coupled_components_dense_and_block_sparse(compiled):
+    from nonsmooth_rod.solvers.gauss_seidel import dense_to_blocks
+    from nonsmooth_rod.solvers.sticking import coupled_components
+
+    label_of = coupled_components if compiled else _interpreted(coupled_components)
+    rng = np.random.default_rng(3)
+    for _ in range(50):  # random block patterns: contacts i, j coupled iff their block is non-zero
+        n = int(rng.integers(1, 9))
+        coupled = np.triu(rng.random((n, n)) < 0.25, 1)
+        coupled = coupled | coupled.T | np.eye(n, dtype=bool)
+        W = np.kron(coupled, np.ones((2, 2))) * rng.uniform(0.5, 1.0, (2 * n, 2 * n))
+        dense, sparse = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+        empty = np.zeros(0, dtype=np.int64)
+        groups = label_of(empty, empty, W, dense)
+        indptr, indices, _ = dense_to_blocks(W)
+        assert label_of(indptr, indices, np.zeros((0, 0)), sparse) == groups
+        np.testing.assert_array_equal(dense, sparse)
+        # the same partition as the connected components of the coupling graph (closure by squaring)
+        reach = coupled.astype(int)
+        for _ in range(n):
+            reach = np.minimum(reach @ reach, 1)
+        assert groups == len({tuple(row) for row in reach})
+        for i in range(n):
+            for j in range(n):
+                assert (dense[i] == dense[j]) == bool(reach[i, j])
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_each_group_is_held_alone_as_if_it_were_the_whole_step(compiled):
+    from nonsmooth_rod.solvers.sticking import prefer_sticking_by_group
+
+    run = prefer_sticking_by_group if compiled else _interpreted(prefer_sticking_by_group)
+    W, q, mu_s, mu_d, (W1, q1) = _two_wedged_rods()
+    p, u, states = _free_fall(q)
+    tol = 1e-9 * np.max(np.abs(q))
+    empty = np.zeros(0, dtype=np.int64)
+    assert run(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u, states, 64)
+    p1, u1, states1 = _free_fall(q1)
+    assert prefer_sticking(W1, q1, mu_s[:2], mu_d[:2], np.zeros(2), tol, np.zeros(2), p1, u1, states1)
+    # the holdable rod gets exactly its own held split; the other keeps falling, untouched
+    np.testing.assert_array_equal(p[:4], p1)
+    np.testing.assert_array_equal(states[:2], states1)
+    assert np.all(p[4:] == 0.0) and np.all(u[4:] == q[4:]) and np.all(states[2:] == STATE_OPEN)
+    # a group larger than max_group keeps the solver's answer
+    p, u, states = _free_fall(q)
+    assert not run(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u,
+                   states, 1)
+    assert np.all(p == 0.0)

@@ -132,10 +132,11 @@ class MoreauJean:
         callback = scene.applied_force is not None
         self._solver_error = None
         wall = time.process_time()
-        if not callback and solver_code is not None:
-            getattr(kernels, loop.RUN_STEPS[solver_code])(0, n_steps, params, iparams, model, work, out)
-        else:
-            self._run_stepwise(kernels, scene, n_steps, params, iparams, model, work, out)
+        with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
+            if not callback and solver_code is not None:
+                getattr(kernels, loop.RUN_STEPS[solver_code])(0, n_steps, params, iparams, model, work, out)
+            else:
+                self._run_stepwise(kernels, scene, n_steps, params, iparams, model, work, out)
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": compiled and solver_code is not None, "force_callback": callback}

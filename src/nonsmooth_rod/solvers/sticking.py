@@ -14,6 +14,8 @@ its state (sticking ones inside the μs cone, sliding ones on the μd line with 
 direction kept), open contacts open, and normal complementarity everywhere? The largest such
 set of held contacts wins; the split chosen is the one deepest inside every cone (maximal
 smallest margin min(p_N, μs p_N − |p_T|)), found by a small dense simplex. See docs/friction.md.
+`prefer_sticking_by_group` runs it on each group of coupled contacts alone (the step's problem is
+block-diagonal over them).
 
 Plain arrays and int64 state codes only, decorated with `_jit.jit`: the same source runs
 compiled inside a numba loop and interpreted.
@@ -26,7 +28,10 @@ from .._jit import jit
 
 STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
 MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
-MAX_CANDIDATES = 16  # contacts considered for a held set (beyond: the first 16)
+# Touching, the impulse anywhere in the μs cone, any slip: sticking and sliding relaxed into one
+# mode (the pruning test of prefer_sticking).
+MODE_FREE = 3
+MAX_CANDIDATES = 16  # contacts that survive the pruning considered for a held set (beyond: the first 16)
 MAX_TRIALS = 64  # feasibility problems per step at most
 SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driven LP
 PIVOT_TOL = 1e-11
@@ -132,28 +137,33 @@ def simplex_max(c, G, h, x):
 
 @jit
 def _unknowns(mode, sign, mu_d):
-    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking ones; a
-    sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode (u_N = 0 of closed
-    contacts, u_T = 0 of sticking ones)."""
+    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking (and free)
+    ones; a sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode (u_N = 0 of
+    closed contacts, u_T = 0 of sticking ones)."""
     na = mode.shape[0]
-    n_x = 0
+    n_x, n_rows = 0, 0
     for i in range(na):
-        n_x += 2 if mode[i] == MODE_STICK else (1 if mode[i] == MODE_SLIDE else 0)
+        if mode[i] != MODE_OPEN:
+            n_x += 1 if mode[i] == MODE_SLIDE else 2
+            n_rows += 2 if mode[i] == MODE_STICK else 1
     P = np.zeros((2 * na, n_x))
-    rows = np.empty(n_x, dtype=np.int64)
-    k = 0
+    rows = np.empty(n_rows, dtype=np.int64)
+    k, r = 0, 0
     for i in range(na):
         if mode[i] == MODE_OPEN:
             continue
         P[2 * i, k] = 1.0
-        rows[k] = 2 * i
-        if mode[i] == MODE_STICK:
-            P[2 * i + 1, k + 1] = 1.0
-            rows[k + 1] = 2 * i + 1
-            k += 2
-        else:
+        rows[r] = 2 * i
+        r += 1
+        if mode[i] == MODE_SLIDE:
             P[2 * i + 1, k] = -mu_d[i] * sign[i]
             k += 1
+            continue
+        P[2 * i + 1, k + 1] = 1.0
+        k += 2
+        if mode[i] == MODE_STICK:
+            rows[r] = 2 * i + 1
+            r += 1
     return P, rows
 
 
@@ -200,7 +210,7 @@ def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
         h[n] = p0[2 * i]
         weight[n] = 1.0
         n += 1
-        if mode[i] == MODE_STICK:
+        if mode[i] == MODE_STICK or mode[i] == MODE_FREE:
             for side in (-1.0, 1.0):
                 G[n] = mu_s[i] * Pz[2 * i] + side * Pz[2 * i + 1]
                 h[n] = mu_s[i] * p0[2 * i] + side * p0[2 * i + 1]
@@ -258,8 +268,8 @@ def _split_obeys_law(W, q, mode, sign, mu_s, p, u, velocity_tol, scale):
             continue
         if pn < -p_tol or abs(un) > velocity_tol:
             return False
-        if mode[i] == MODE_STICK:
-            if abs(ut) > velocity_tol or abs(pt) > mu_s[i] * pn + p_tol:
+        if mode[i] == MODE_STICK or mode[i] == MODE_FREE:
+            if (mode[i] == MODE_STICK and abs(ut) > velocity_tol) or abs(pt) > mu_s[i] * pn + p_tol:
                 return False
         elif sign[i] * ut < -velocity_tol:
             return False
@@ -294,11 +304,9 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
 def _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates):
     """Contacts that started the step at rest (guess 0), touch at its end (u_N = 0, or u_N equal to
     the gap-closing velocity) and slide: they must be held if any admissible split can hold them.
-    Returns how many (≤ MAX_CANDIDATES)."""
+    Returns how many."""
     n = 0
     for i in range(start_guess.shape[0]):
-        if n == MAX_CANDIDATES:
-            break
         touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
         if states[i] != STATE_STICK and start_guess[i] == 0.0 and touching \
                 and abs(u[2 * i + 1]) > velocity_tol:
@@ -308,9 +316,9 @@ def _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates
 
 
 @jit
-def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign):
+def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign, others_free):
     """Mode of every contact when the candidates in `held_mask` stick and the others slide their
-    way; the rest keep their state (stick, slide, open)."""
+    way (or, `others_free`, are free: MODE_FREE); the rest keep their state (stick, slide, open)."""
     for i in range(states.shape[0]):
         sign[i] = 0.0
         if states[i] == STATE_STICK:
@@ -324,6 +332,9 @@ def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign):
         i = candidates[c]
         if (held_mask >> c) & 1:
             mode[i] = MODE_STICK
+            sign[i] = 0.0
+        elif others_free:
+            mode[i] = MODE_FREE
             sign[i] = 0.0
         else:
             mode[i] = MODE_SLIDE
@@ -375,6 +386,10 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     contact to close an open gap (0 if none) — a held mode may instead leave it open;
     states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
     The largest held set wins (ties: the first in contact order); at most MAX_TRIALS tries.
+    With several candidates, each is first tried alone with the other candidates free (MODE_FREE:
+    touching, impulse in the μs cone, any slip) — a relaxation of every mode that holds it, and
+    monotone: a candidate that cannot be held so is in no held set, and is dropped. A collision
+    cascade (n candidates, none holdable) then costs n small LPs instead of 2ⁿ − 1.
     """
     na = mu_s.shape[0]
     candidates = np.empty(na, dtype=np.int64)
@@ -389,25 +404,148 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     sign = np.zeros(na)
     p_new = np.zeros(2 * na)
     q_held = np.empty(2 * na)
-    chases_gaps = np.max(closing) > 0.0
-    trials = 0
-    for size in range(n_c, 0, -1):
+    n_c = min(n_c, 62)  # a bit mask of the candidates
+    everything = (1 << n_c) - 1
+    _modes_for(everything, candidates, n_c, u, states, mode, sign, False)  # the common case: all held
+    if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+        _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
+        return True
+    kept = n_c
+    if n_c > 1:  # pruning: each candidate alone, with the other candidates free
+        kept = 0
+        for c in range(n_c):
+            _modes_for(1 << c, candidates, n_c, u, states, mode, sign, True)
+            if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+                candidates[kept] = candidates[c]
+                kept += 1
+    largest = kept - 1 if kept == n_c else kept  # the whole set of n_c was tried above
+    n_c = min(kept, MAX_CANDIDATES)
+    trials = 1
+    for size in range(min(largest, n_c), 0, -1):
         for held in range(1, 1 << n_c):
             if _popcount(held) != size:
                 continue
             if trials == MAX_TRIALS:
                 return False
             trials += 1
-            _modes_for(held, candidates, n_c, u, states, mode, sign)
-            admissible = admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
-            if not admissible and chases_gaps:
-                _without_gap_closing(q, closing, mode, q_held)
-                admissible = admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
-            if admissible:
+            _modes_for(held, candidates, n_c, u, states, mode, sign, False)
+            if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
                 _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
                 return True
     return False
 
 
-__all__ = ["prefer_sticking", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK",
-           "STATE_SLIP_PLUS", "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE"]
+@jit
+def _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+    """admissible_split of the mode for the step's q, or else (a held body need not chase gaps of
+    position round-off) for q without its gap-closing part."""
+    if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+        return True
+    if np.max(closing) <= 0.0:
+        return False
+    _without_gap_closing(q, closing, mode, q_held)
+    return admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+
+
+@jit
+def coupled_components(indptr, indices, W, label):
+    """Label the contacts by group of coupled contacts — those linked through non-zero blocks of
+    W (contacts sharing a body, directly or along a chain) — from the block-sparse layout
+    (indptr, indices) or, when indptr is empty, the dense W. Returns the number of groups."""
+    na = label.shape[0]
+    label[:] = -1
+    stack = np.empty(na, dtype=np.int64)
+    groups = 0
+    for seed in range(na):
+        if label[seed] >= 0:
+            continue
+        label[seed] = groups
+        top = 1
+        stack[0] = seed
+        while top > 0:
+            top -= 1
+            i = stack[top]
+            sparse = indptr.shape[0] > 0
+            for k in range(indptr[i] if sparse else 0, indptr[i + 1] if sparse else na):
+                j = indices[k] if sparse else k
+                if label[j] < 0 and (sparse or W[2 * i, 2 * j] != 0.0 or W[2 * i, 2 * j + 1] != 0.0
+                                     or W[2 * i + 1, 2 * j] != 0.0 or W[2 * i + 1, 2 * j + 1] != 0.0):
+                    label[j] = groups
+                    stack[top] = j
+                    top += 1
+        groups += 1
+    return groups
+
+
+@jit
+def _group_problem(members, W, indptr, indices, blocks):
+    """The dense W of one group of contacts (`members`, ascending), from W or its blocks."""
+    n = members.shape[0]
+    Wg = np.zeros((2 * n, 2 * n))
+    position = np.full(indptr.shape[0] - 1 if indptr.shape[0] > 0 else W.shape[0] // 2, -1, dtype=np.int64)
+    for a in range(n):
+        position[members[a]] = a
+    for a in range(n):
+        i = members[a]
+        if indptr.shape[0] > 0:
+            for k in range(indptr[i], indptr[i + 1]):
+                b = position[indices[k]]
+                if b >= 0:
+                    for r in range(2):
+                        for c in range(2):
+                            Wg[2 * a + r, 2 * b + c] = blocks[k, r, c]
+        else:
+            for b in range(n):
+                for r in range(2):
+                    for c in range(2):
+                        Wg[2 * a + r, 2 * b + c] = W[2 * i + r, 2 * members[b] + c]
+    return Wg
+
+
+@jit
+def _gather(members, x, pairs):
+    """x at the group's contacts (pairs: two entries per contact, N and T)."""
+    out = np.empty(members.shape[0] * (2 if pairs else 1), dtype=x.dtype)
+    for a in range(members.shape[0]):
+        if pairs:
+            out[2 * a], out[2 * a + 1] = x[2 * members[a]], x[2 * members[a] + 1]
+        else:
+            out[a] = x[members[a]]
+    return out
+
+
+@jit
+def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
+                             states, max_group):
+    """prefer_sticking on each group of coupled contacts alone (coupled_components). The step's
+    problem is block-diagonal over the groups, so the largest held set of the whole step is the
+    union of each group's, and each search is over its own candidates: 2^n_g small dense LPs
+    rather than 2^(Σ n_g) large ones. Only groups with a contact that started at rest and does
+    not stick (start_guess 0) are searched, and only those of at most `max_group` contacts.
+    W is dense, or empty with its block-sparse form. True when any p, u, states changed."""
+    na = mu_s.shape[0]
+    label = np.empty(na, dtype=np.int64)
+    groups = coupled_components(indptr, indices, W, label)
+    changed = False
+    for g in range(groups):
+        members = np.flatnonzero(label == g)
+        wanted = False
+        for i in members:
+            wanted = wanted or (start_guess[i] == 0.0 and states[i] != STATE_STICK)
+        if not wanted or members.shape[0] > max_group:
+            continue
+        Wg = _group_problem(members, W, indptr, indices, blocks)
+        pg, ug, states_g = _gather(members, p, True), _gather(members, u, True), _gather(members, states, False)
+        if prefer_sticking(Wg, _gather(members, q, True), _gather(members, mu_s, False),
+                           _gather(members, mu_d, False), _gather(members, start_guess, False), velocity_tol,
+                           _gather(members, closing, False), pg, ug, states_g):
+            for a in range(members.shape[0]):
+                i = members[a]
+                p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1] = pg[2 * a], pg[2 * a + 1], ug[2 * a], ug[2 * a + 1]
+                states[i] = states_g[a]
+            changed = True
+    return changed
+
+
+__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK",
+           "STATE_SLIP_PLUS", "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE"]

@@ -32,7 +32,7 @@ from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER
                       lemke_interval, pgs_block, solve_enum, solve_interval, solve_lemke, solve_pgs)
 from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
-from .sticking import prefer_sticking
+from .sticking import prefer_sticking_by_group
 
 COMPILED_SOLVERS = SOLVER_CODES  # solver name -> code of the compiled kernels
 
@@ -131,8 +131,9 @@ def _interval_of(mu_s, mu_d, guess, lo, hi):
         hi[j] = shift + mu_s[j]
 
 
-# Statically indeterminate holds are searched on a dense W; pgs scenes larger than this (piles,
-# rows of hundreds of balls) keep the solver's split rather than densify every such step.
+# Statically indeterminate holds are searched on a dense W per group of coupled contacts; a
+# group larger than this (a pile of hundreds of disks) keeps the solver's split. pgs steps of at
+# most this many contacts that Gauss–Seidel cannot finish are solved again by Lemke.
 MAX_DENSE_HOLD = 64
 
 
@@ -210,11 +211,12 @@ def _guess_of_states(states, guess):
 @jit
 def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
                  states):
-    """Hold what μs can hold (sticking.prefer_sticking) when a contact that started the step at
-    rest — slip velocity round-off at the step's start (`resting` 1), slip guess 0 — does not
-    stick; True when p, u, states were replaced. The common step returns at once. A contact
-    that was already sliding (or grazing a rolling neighbour) keeps the solver's answer: the
-    search costs milliseconds on rows of balls and has nothing to hold there."""
+    """Hold what μs can hold (sticking.prefer_sticking, group by group of coupled contacts) when a
+    contact that started the step at rest — slip velocity round-off at the step's start
+    (`resting` 1), slip guess 0 — does not stick; True when p, u, states were replaced. The
+    common step returns at once. A contact that was already sliding (or grazing a rolling
+    neighbour) keeps the solver's answer: the search costs milliseconds on rows of balls and has
+    nothing to hold there. Groups of more than MAX_DENSE_HOLD contacts keep the solver's split."""
     na = mu_s.shape[0]
     at_rest = np.empty(na)
     moving = False
@@ -224,11 +226,8 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
             moving = True
     if not moving:
         return False
-    if W.shape[0] == 0:
-        if na > MAX_DENSE_HOLD:
-            return False
-        W = _dense_of(indptr, indices, blocks, na)
-    return prefer_sticking(W, q, mu_s, mu_d, at_rest, velocity_tol, closing, p, u, states)
+    return prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, at_rest, velocity_tol, closing, p,
+                                    u, states, MAX_DENSE_HOLD)
 
 
 @jit
