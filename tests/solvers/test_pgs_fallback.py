@@ -3,7 +3,8 @@
 Gauss–Seidel drifts along the null space of a singular W and can stall just above its
 acceptance (a pile of disks: tens of coupled, statically indeterminate contacts). Such a step,
 with at most MAX_DENSE_HOLD contacts, is handed to Lemke; the run counts it in
-stats["solver_fallbacks"] and goes on.
+stats["solver_fallbacks"] and goes on. A user who set pgs's own sweep limit or tolerance gets
+pgs alone (its failure is reported: tests/integrators/test_solver_failure_report.py).
 """
 from __future__ import annotations
 
@@ -27,7 +28,7 @@ def test_a_step_one_sweep_leaves_unsolved_is_solved_by_the_fallback():
         == KERNEL_NO_CONVERGENCE
     p, u = np.zeros(4), problem.q.copy()
     status, iterations, residual, fell_back = pgs_or_lemke(indptr, indices, blocks, problem.q, problem.lo,
-                                                           problem.hi, p, u, 0.0, 1)
+                                                           problem.hi, p, u, 0.0, 1, True)
     assert (status, fell_back) == (KERNEL_SOLVED, 1)
     assert iterations > 1  # the sweep and Lemke's pivots
     scale = residual_scale(problem, p, u)
@@ -39,8 +40,13 @@ def test_a_converged_pgs_step_does_not_fall_back():
     problem = block_on_incline(0.3, 0.5)
     indptr, indices, blocks = dense_to_blocks(problem.W)
     p, u = np.zeros(4), problem.q.copy()
-    status, _, _, fell_back = pgs_or_lemke(indptr, indices, blocks, problem.q, problem.lo, problem.hi, p, u, 0.0, 0)
+    status, _, _, fell_back = pgs_or_lemke(indptr, indices, blocks, problem.q, problem.lo, problem.hi, p, u, 0.0, 0,
+                                           True)
     assert (status, fell_back) == (KERNEL_SOLVED, 0)
+    # without the fallback (the user set pgs's own sweep limit or tolerance) the failure stands
+    p, u = np.zeros(4), problem.q.copy()
+    assert pgs_or_lemke(indptr, indices, blocks, problem.q, problem.lo, problem.hi, p, u, 0.0, 1, False)[::3] \
+        == (KERNEL_NO_CONVERGENCE, 0)
 
 
 @pytest.fixture(scope="module")

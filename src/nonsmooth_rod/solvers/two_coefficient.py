@@ -151,14 +151,15 @@ def _dense_of(indptr, indices, blocks, na):
 
 
 @jit
-def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-    """pgs on the block-sparse W; a step it cannot solve with at most MAX_DENSE_HOLD contacts is
-    solved again by Lemke on the dense W. Gauss–Seidel can stall on a singular W (a pile: many
-    coupled contacts, q a little outside W's range) just above its acceptance, where Lemke's
-    pivoting is exact. Returns (status, sweeps + pivots, residual, 1 if it fell back else 0)."""
+def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback):
+    """pgs on the block-sparse W; with `fallback`, a step it cannot solve with at most
+    MAX_DENSE_HOLD contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
+    singular W (a pile: many coupled contacts, q a little outside W's range) just above its
+    acceptance, where Lemke's pivoting is exact. Returns (status, sweeps + pivots, residual,
+    1 if it fell back else 0)."""
     status, sweeps, residual = pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
     na = lo.shape[0]
-    if status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
+    if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
         return status, sweeps, residual, 0
     W = _dense_of(indptr, indices, blocks, na)
     status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0)  # Lemke's own acceptance
@@ -171,8 +172,8 @@ def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_i
 
     Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
     that solver (`_solve_compiled`); lemke and enum then take the dense W."""
-    if indptr.shape[0] > 0:
-        return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+    if indptr.shape[0] > 0:  # pgs's own settings (tol, max_iter) given: no Lemke behind them
+        return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, rtol <= 0.0 and max_iter <= 0)
     status, iterations, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
     return status, iterations, residual, 0
 
@@ -195,7 +196,8 @@ if _jit.ENABLED:
         if getattr(solver_code, "literal_value", None) == SOLVER_PGS:
             def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
                 if indptr.shape[0] > 0:
-                    return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+                    return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter,
+                                        rtol <= 0.0 and max_iter <= 0)
                 status, iterations, residual = solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
                 return status, iterations, residual, 0
             return solve_pgs_either
