@@ -6,8 +6,8 @@ Scenes: the paper's rod, each toy, a frictionless ladder (2 contacts, 1 body), a
 on a floor (N − 1 disk–disk and N disk–floor contacts, the first ball rolling into the others),
 and a pyramid pile of disks on a floor — with lemke and pgs (lemke only up to 32 contacts: its
 dense tableau grows as contacts³). Each run is timed whole (CPU time / steps, median of the
-repeats) next to the yardstick, one 3×3 numpy.linalg.solve in a Python loop, timed in the same
-run; ratios are what to read on a shared machine. MuJoCo (mj_step) steps the ball rows and the
+repeats) next to the yardstick, one 3×3 numpy.linalg.solve in a Python loop, timed again just
+before each scene (the shared machine's speed drifts within a run); ratios are what to read. MuJoCo (mj_step) steps the ball rows and the
 pile when `mujoco` is installed (optional extra `bench`); PyBullet likewise when `pybullet` is.
 
 The cold compile time is a subprocess with an empty NUMBA_CACHE_DIR running one short rod run
@@ -118,7 +118,7 @@ def cold_compile_seconds() -> float:
     return walls[0], walls[1]
 
 
-def plot_rows(rows_cost: dict, yard: float, path: str) -> None:
+def plot_rows(rows_cost: dict, path: str) -> None:
     """Cost per step against the number of balls of a row, every engine, log–log, in yardsticks."""
     import matplotlib
 
@@ -129,7 +129,7 @@ def plot_rows(rows_cost: dict, yard: float, path: str) -> None:
     fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
     for key, points in rows_cost.items():
         n, us = zip(*points)
-        ax.loglog(n, [u / yard for u in us], "o-", label=labels.get(key, key))
+        ax.loglog(n, us, "o-", label=labels.get(key, key))
     ax.set(xlabel="balls in the row N (2N − 1 contacts)", ylabel="cost per step [× yardstick]",
            title="a row of N balls on a floor, h = 1 ms")
     ax.grid(True, which="both", alpha=0.3)
@@ -147,16 +147,17 @@ def main(argv=None) -> int:
     parser.add_argument("--only", default="", help="run only the scenes whose name contains this")
     parser.add_argument("--plot", default=None, metavar="PNG", help="log–log plot of cost per step against N (rows)")
     args = parser.parse_args(argv)
-    rows_cost = {}  # engine/solver → [(N balls, µs per step)] for the ball rows
+    rows_cost = {}  # engine/solver → [(N balls, yardsticks per step)] for the ball rows
     repeats = 2 if args.quick else args.repeats
     max_balls = args.max_balls or (32 if args.quick else 256)
     h, steps = 1e-3, (50 if args.quick else 500)
-    yard = yardstick_us(repeats=repeats)
-    print(f"yardstick (3x3 numpy.linalg.solve in a Python loop): {yard:.2f} us")
+    yards = []  # the yardstick again before each scene: the shared machine's speed drifts in a run
     print(f"{'scene':28s} {'contacts':>8s} {'solver':>6s} {'us/step':>10s} {'x yardstick':>11s}  compiled")
     for name, (scene, q0, v0) in scenes(max_balls, args.quick):
         if args.only not in name:
             continue
+        yard = yardstick_us(n=5000, repeats=3)
+        yards.append(yard)
         nc = len(scene.contacts)
         for solver in ("lemke", "pgs"):
             if solver == "lemke" and nc > LEMKE_MAX_CONTACTS:
@@ -165,13 +166,16 @@ def main(argv=None) -> int:
             note = "" if run.status == "ok" else f"  {run.status}: {run.message[:60]}"
             print(f"{name:28s} {nc:8d} {solver:>6s} {us:10.1f} {us / yard:11.2f}  {run.stats['compiled']}{note}")
             if name.startswith("ball row"):
-                rows_cost.setdefault(solver, []).append((len(scene.bodies), us))
+                rows_cost.setdefault(solver, []).append((len(scene.bodies), us / yard))
         for engine, cost in other_engines_us(name, scene, h, steps, repeats):
             print(f"{name:28s} {nc:8d} {engine:>6s} {cost:10.1f} {cost / yard:11.2f}  (its own step)")
             if name.startswith("ball row"):
-                rows_cost.setdefault(engine, []).append((len(scene.bodies), cost))
+                rows_cost.setdefault(engine, []).append((len(scene.bodies), cost / yard))
+    yard = statistics.median(yards) if yards else yardstick_us(repeats=repeats)
+    print(f"yardstick (3x3 numpy.linalg.solve in a Python loop, measured before each scene): median {yard:.2f} us, "
+          f"{min(yards, default=yard):.2f}-{max(yards, default=yard):.2f}")
     if args.plot:
-        plot_rows(rows_cost, yard, args.plot)
+        plot_rows(rows_cost, args.plot)
     if not args.no_compile_time:
         cold, warm = cold_compile_seconds()
         print(f"first run, empty numba cache: {cold:.1f} s ({cold * 1e6 / yard:.2g} yardsticks); "
