@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
-from nonsmooth_rod.solvers.sticking import (STATE_OPEN, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking,
+from nonsmooth_rod.solvers.sticking import (STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking,
                                             simplex_max)
 from nonsmooth_rod.toys import WedgedRod
 
@@ -215,3 +215,98 @@ def test_each_group_is_held_alone_as_if_it_were_the_whole_step(compiled):
     assert not run(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u,
                    states, 1)
     assert np.all(p == 0.0)
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_candidates_no_split_can_hold_are_pruned_and_the_others_still_held(compiled):
+    """One problem, four candidates (both rods' wall contacts slide from rest): the falling rod's
+    two are pruned (not holdable even with every other candidate free), the holdable rod is held."""
+    run = prefer_sticking if compiled else _interpreted(prefer_sticking)
+    W, q, mu_s, mu_d, (W1, q1) = _two_wedged_rods()
+    p, u, states = _free_fall(q)
+    tol = 1e-9 * np.max(np.abs(q))
+    assert run(W, q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u, states)
+    assert list(states) == [STATE_STICK, STATE_STICK, STATE_OPEN, STATE_OPEN]
+    assert np.max(np.abs(u[:4])) <= 1e-9 * np.max(np.abs(q))  # the held rod ends the step at rest
+    assert np.all(p[4:] == 0.0) and np.all(u[4:] == q[4:])  # the other falls, untouched
+    assert p[3] - p[1] == pytest.approx(H * 9.81, rel=1e-9)  # friction carries the held rod's weight
+
+
+def _exhaustive_hold(W, q, mu_s, mu_d, p, u, states, tol):
+    """The held set without pruning: every subset of the candidates, largest first (the search
+    before the pruning), via admissible_split; returns the held states or None."""
+    from itertools import combinations
+
+    from nonsmooth_rod.solvers.sticking import MODE_OPEN, MODE_SLIDE, MODE_STICK, admissible_split
+
+    na = len(mu_s)
+    cand = [i for i in range(na) if states[i] != STATE_STICK and abs(u[2 * i]) <= tol and abs(u[2 * i + 1]) > tol]
+    scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / np.max(np.abs(W)))
+    for size in range(len(cand), 0, -1):
+        for held in combinations(cand, size):
+            mode = np.array([MODE_STICK if (i in held or states[i] == STATE_STICK) else
+                             (MODE_OPEN if states[i] == STATE_OPEN and i not in cand else MODE_SLIDE)
+                             for i in range(na)], dtype=np.int64)
+            sign = np.array([0.0 if mode[i] != MODE_SLIDE else np.sign(u[2 * i + 1]) for i in range(na)])
+            if admissible_split(W, q, mu_s, mu_d, mode, sign, tol, scale, np.zeros(2 * na)):
+                return sorted(held)
+    return None
+
+
+def _block_diagonal(*problems):
+    n = sum(len(q) for _, q in problems)
+    W, k = np.zeros((n, n)), 0
+    for Wi, qi in problems:
+        W[k:k + len(qi), k:k + len(qi)] = Wi
+        k += len(qi)
+    return W, np.concatenate([qi for _, qi in problems])
+
+
+def _lemke_start(W, q, mu_s):
+    """The step's Lemke solution under the μs interval (slip guess 0) and its contact states."""
+    from nonsmooth_rod.solvers import PlanarFrictionProblem, solve
+
+    sol = solve(PlanarFrictionProblem(W, q, -mu_s, mu_s), "lemke")
+    tol = 1e-9 * np.max(np.abs(q))
+    states = np.array([STATE_OPEN if sol.p[2 * i] <= 1e-12 * np.max(np.abs(sol.p), initial=1e-300) else
+                       STATE_STICK if abs(sol.u[2 * i + 1]) <= tol else
+                       (STATE_SLIP_PLUS if sol.u[2 * i + 1] > 0 else STATE_SLIP_MINUS) for i in range(len(mu_s))],
+                      dtype=np.int64)
+    return np.array(sol.p), np.array(sol.u), states
+
+
+def _rod(deg, mu):
+    return _step_problem(WedgedRod(angle=math.radians(deg), mu_s=mu, mu_d=0.8 * mu)), [mu, mu]
+
+
+def _pyramid(mu_disks, mu_floor):
+    from nonsmooth_rod.toys import DiskPyramid
+
+    toy = DiskPyramid(mu_disks=mu_disks, mu_disks_d=0.8 * mu_disks, mu_floor=mu_floor, mu_floor_d=0.8 * mu_floor)
+    return _step_problem(toy), [mu_floor, mu_floor, mu_disks, mu_disks]
+
+
+CASES = {  # several holdable and unholdable groups in one step problem (exhaustive answers: [0, 1],
+    # [0, 1, 4, 5], none, [2, 4, 5]: the pyramid short of friction holds one top contact)
+    "two rods, one holds": [_rod(30.0, 0.7), _rod(30.0, 0.5)],
+    "three rods, two hold": [_rod(20.0, 0.4), _rod(35.0, 0.6), _rod(35.0, 0.75)],
+    "pyramid that holds and a rod that falls": [_pyramid(0.34, 0.12), _rod(30.0, 0.5)],
+    "pyramid short of friction and a rod that holds": [_pyramid(0.32, 0.12), _rod(30.0, 0.7)],
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_pruned_search_holds_the_same_contacts_as_the_exhaustive_one(case):
+    parts = CASES[case]
+    W, q = _block_diagonal(*(problem for problem, _ in parts))
+    mu_s = np.concatenate([mu for _, mu in parts])
+    mu_d = 0.8 * mu_s
+    p, u, states = _lemke_start(W, q, mu_s)
+    n = len(mu_s)
+    tol = 1e-9 * np.max(np.abs(q))
+    expected = _exhaustive_hold(W, q, mu_s, mu_d, p, u, states, tol)
+    sticking_before = set(np.flatnonzero(states == STATE_STICK))
+    held = prefer_sticking(W, q, mu_s, mu_d, np.zeros(n), tol, np.zeros(n), p, u, states)
+    assert held == (expected is not None)
+    if held:
+        assert sorted(set(np.flatnonzero(states == STATE_STICK)) - sticking_before) == expected

@@ -405,12 +405,6 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     p_new = np.zeros(2 * na)
     q_held = np.empty(2 * na)
     n_c = min(n_c, 62)  # a bit mask of the candidates
-    everything = (1 << n_c) - 1
-    _modes_for(everything, candidates, n_c, u, states, mode, sign, False)  # the common case: all held
-    if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-        _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
-        return True
-    kept = n_c
     if n_c > 1:  # pruning: each candidate alone, with the other candidates free
         kept = 0
         for c in range(n_c):
@@ -418,10 +412,9 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
             if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
                 candidates[kept] = candidates[c]
                 kept += 1
-    largest = kept - 1 if kept == n_c else kept  # the whole set of n_c was tried above
-    n_c = min(kept, MAX_CANDIDATES)
-    trials = 1
-    for size in range(min(largest, n_c), 0, -1):
+        n_c = min(kept, MAX_CANDIDATES)
+    trials = 0
+    for size in range(n_c, 0, -1):
         for held in range(1, 1 << n_c):
             if _popcount(held) != size:
                 continue
