@@ -26,6 +26,11 @@ def _row(n, all_pairs):
 
 
 def test_all_pairs_listed_give_the_neighbours_run():
+    # 15 listed pairs go through the broad phase (more than BROAD_PHASE_MIN_PAIRS), the 5 neighbour
+    # pairs do not: the sorted and the unsorted run must agree
+    from nonsmooth_rod.integrators.moreau_jean_loop import BROAD_PHASE_MIN_PAIRS
+
+    assert 5 <= BROAD_PHASE_MIN_PAIRS < 15
     runs = [MoreauJean(MoreauJeanOptions(h=1e-3)).run(*_row(6, all_pairs), 0.1) for all_pairs in (False, True)]
     neighbours, everything = runs
     pair_impacts = [i.contact for i in neighbours.impacts if not i.contact.startswith("floor")]

@@ -471,7 +471,7 @@ def coupled_components(indptr, indices, W, label):
 
 
 @jit
-def _group_problem(members, W, indptr, indices, blocks):
+def group_matrix(members, W, indptr, indices, blocks):
     """The dense W of one group of contacts (`members`, ascending), from W or its blocks."""
     n = members.shape[0]
     Wg = np.zeros((2 * n, 2 * n))
@@ -496,7 +496,7 @@ def _group_problem(members, W, indptr, indices, blocks):
 
 
 @jit
-def _gather(members, x, pairs):
+def gather_contacts(members, x, pairs):
     """x at the group's contacts (pairs: two entries per contact, N and T)."""
     out = np.empty(members.shape[0] * (2 if pairs else 1), dtype=x.dtype)
     for a in range(members.shape[0]):
@@ -527,11 +527,11 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
             wanted = wanted or (start_guess[i] == 0.0 and states[i] != STATE_STICK)
         if not wanted or members.shape[0] > max_group:
             continue
-        Wg = _group_problem(members, W, indptr, indices, blocks)
-        pg, ug, states_g = _gather(members, p, True), _gather(members, u, True), _gather(members, states, False)
-        if prefer_sticking(Wg, _gather(members, q, True), _gather(members, mu_s, False),
-                           _gather(members, mu_d, False), _gather(members, start_guess, False), velocity_tol,
-                           _gather(members, closing, False), pg, ug, states_g):
+        Wg = group_matrix(members, W, indptr, indices, blocks)
+        pg, ug, states_g = gather_contacts(members, p, True), gather_contacts(members, u, True), gather_contacts(members, states, False)
+        if prefer_sticking(Wg, gather_contacts(members, q, True), gather_contacts(members, mu_s, False),
+                           gather_contacts(members, mu_d, False), gather_contacts(members, start_guess, False), velocity_tol,
+                           gather_contacts(members, closing, False), pg, ug, states_g):
             for a in range(members.shape[0]):
                 i = members[a]
                 p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1] = pg[2 * a], pg[2 * a + 1], ug[2 * a], ug[2 * a + 1]
@@ -540,5 +540,5 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
     return changed
 
 
-__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK",
+__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK",
            "STATE_SLIP_PLUS", "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE"]
