@@ -10,11 +10,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _bench_scenes():
-    spec = importlib.util.spec_from_file_location("bench_scenes", ROOT / "benchmarks" / "bench_scenes.py")
+def _benchmark(name):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def _bench_scenes():
+    return _benchmark("bench_scenes")
 
 
 def test_bench_scenes_quick_runs(capsys):
@@ -22,3 +26,13 @@ def test_bench_scenes_quick_runs(capsys):
     lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("ladder")]
     assert [line.split()[2] for line in lines] == ["lemke", "pgs"]
     assert all(line.split()[-1] == "True" for line in lines)  # compiled
+
+
+def test_bench_moreau_jean_quick_labels_compiled_and_interpreted_rows(capsys):
+    assert _benchmark("bench_moreau_jean").main(["--quick"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if "(compiled)" in line
+            or "(interpreted)" in line]
+    labels = [" ".join(row[:2]) for row in rows]
+    assert labels == [f"{s} (compiled)" for s in ("lemke", "pgs", "enum")] + \
+        [f"{s} (interpreted)" for s in ("lemke", "pgs", "enum")]
+    assert all("FAILED" not in " ".join(row) and int(row[-1]) > 0 for row in rows)  # every run reached B's impact
