@@ -81,6 +81,11 @@ def whole_vs_integrator(h: float, repeats: int) -> tuple[float, float]:
     return statistics.median(whole), statistics.median(integrator)
 
 
+def yardstick_s(n: int = 20000, repeats: int = 3) -> float:
+    """The yardstick in seconds."""
+    return yardstick_us(n, repeats) * 1e-6
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="one repeat, no cold compile, h = 1e-2, 1e-3")
@@ -106,8 +111,3 @@ def main(argv=None) -> int:
 
 if __name__ == "__main__":
     sys.exit(main())
-
-
-def yardstick_s(n: int = 20000, repeats: int = 3) -> float:
-    """The yardstick in seconds."""
-    return yardstick_us(n, repeats) * 1e-6

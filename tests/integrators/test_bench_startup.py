@@ -32,3 +32,14 @@ def test_moreau_jean_run_of_a_scene_does_not_import_scipy_integrate():
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split("\n")[-2] == "[]"
+
+
+def test_every_benchmark_ends_with_its_main_guard():
+    """A definition after `if __name__ == "__main__":` exists when the module is imported (the
+    tests) but not when it runs as a script: bench_startup.py once failed that way."""
+    import ast
+
+    for path in sorted((ROOT / "benchmarks").glob("*.py")):
+        body = ast.parse(path.read_text()).body
+        guards = [i for i, node in enumerate(body) if isinstance(node, ast.If) and "__main__" in ast.unparse(node.test)]
+        assert not guards or guards[-1] == len(body) - 1, f"{path.name}: statements after the main guard"
