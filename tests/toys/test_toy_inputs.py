@@ -4,6 +4,7 @@ import math
 import pytest
 
 from nonsmooth_rod import toys
+from nonsmooth_rod.toys import stacks
 from nonsmooth_rod.validation import InputError
 
 BAD = [
@@ -17,6 +18,11 @@ BAD = [
     (lambda: toys.BallRow(gaps=(-0.1,)), "non-negative"),
     (lambda: toys.BallRow.cradle(4).simultaneous_outcome(), "three equal balls"),
     (lambda: toys.run(toys.BouncingBall(), "runge-kutta"), "unknown method"),
+    (lambda: stacks.ball_row(0), "n (balls) must be a whole number ≥ 1"),
+    (lambda: stacks.ball_row(2.5), "n (balls)"),
+    (lambda: stacks.ball_row(3, radius=-0.05), "radius"),
+    (lambda: stacks.disk_pile(0), "rows must be a whole number ≥ 1"),
+    (lambda: stacks.disk_pile(3, mass=float("nan")), "mass"),
 ]
 
 
