@@ -7,8 +7,9 @@ on a floor (N − 1 disk–disk and N disk–floor contacts, the first ball roll
 and a pyramid pile of disks on a floor — with lemke and pgs (lemke only up to 32 contacts: its
 dense tableau grows as contacts³). Each run is timed whole (CPU time / steps, median of the
 repeats) next to the yardstick, one 3×3 numpy.linalg.solve in a Python loop, timed again just
-before each scene (the shared machine's speed drifts within a run); ratios are what to read. MuJoCo (mj_step) steps the ball rows and the
-pile when `mujoco` is installed (optional extra `bench`); PyBullet likewise when `pybullet` is.
+before each scene (the shared machine's speed drifts within a run); ratios are what to read.
+MuJoCo (mj_step) steps the ball rows and the pile when `mujoco` is installed (optional extra
+`bench`); PyBullet likewise when `pybullet` is.
 
 The cold compile time is a subprocess with an empty NUMBA_CACHE_DIR running one short rod run
 (issue 16's target: ≤ 5 s on an idle 2-core machine).
@@ -41,7 +42,6 @@ import other_engines  # noqa: E402  (benchmarks/other_engines.py)
 from yardstick import yardstick_us  # noqa: E402  (benchmarks/yardstick.py)
 
 LEMKE_MAX_CONTACTS = 32
-ball_row, pile = stacks.ball_row, stacks.disk_pile  # the same scenes the tests run
 
 
 def ladder():
@@ -63,19 +63,17 @@ def scenes(max_balls: int, quick: bool):
     yield "ladder", ladder()
     n = 2
     while n <= max_balls:
-        yield f"ball row N={n}", ball_row(n)
+        yield f"ball row N={n}", stacks.ball_row(n)  # the same scenes the tests run
         n *= 4 if quick else 2
-    yield "pile 4 rows", pile(4)
+    yield "pile 4 rows", stacks.disk_pile(4)
     if not quick:
-        yield "pile 8 rows", pile(8)
+        yield "pile 8 rows", stacks.disk_pile(8)
 
 
-def other_engines_us(name, scene, h, steps, repeats):
+def other_engines_us(name, q0, h, steps, repeats):
     """(engine, µs per step) of MuJoCo and PyBullet on the same ball row or pile (when installed)."""
     if not name.startswith(("ball row", "pile")):
         return []
-    q0 = stacks.ball_row(len(scene.bodies))[1] if name.startswith("ball row") else stacks.disk_pile(
-        int(name.split()[1]))[1]
     centres = list(zip(q0[0::3].tolist(), q0[1::3].tolist()))
     first = 1.0 if name.startswith("ball row") else 0.0
     out = []
@@ -167,7 +165,7 @@ def main(argv=None) -> int:
             print(f"{name:28s} {nc:8d} {solver:>6s} {us:10.1f} {us / yard:11.2f}  {run.stats['compiled']}{note}")
             if name.startswith("ball row"):
                 rows_cost.setdefault(solver, []).append((len(scene.bodies), us / yard))
-        for engine, cost in other_engines_us(name, scene, h, steps, repeats):
+        for engine, cost in other_engines_us(name, q0, h, steps, repeats):
             print(f"{name:28s} {nc:8d} {engine:>6s} {cost:10.1f} {cost / yard:11.2f}  (its own step)")
             if name.startswith("ball row"):
                 rows_cost.setdefault(engine, []).append((len(scene.bodies), cost / yard))

@@ -84,3 +84,19 @@ def test_blas_runs_on_one_thread_inside_a_run_and_its_limits_come_back_after():
             pass
         assert [lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"] == before
     assert len(after) == len(inside)
+
+
+def test_nested_blas_limits_restore_once_at_the_outermost_exit():
+    import pytest
+
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads():
+        return {lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"}
+
+    with threadpoolctl.threadpool_limits(2, "blas"):
+        with _jit.one_blas_thread():  # a sweep's batch
+            with _jit.one_blas_thread():  # one run inside it
+                pass
+            assert blas_threads() == {1}  # the inner exit does not lift the batch's limit
+        assert blas_threads() == {2}

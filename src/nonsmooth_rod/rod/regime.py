@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _jit
 from ..io import dumps_json, provenance, write_csv, write_json, write_text
 from ..validation import InputError
 from .problem import RodProblem
@@ -138,7 +139,8 @@ def warm_engine(settings: SweepSettings) -> None:
 
 def _classify_chunk(base: RodProblem, settings: SweepSettings, columns, points) -> list[dict]:
     warm_engine(settings)
-    return [classify_point(base, dict(zip(columns, pt)), settings) for pt in points]
+    with _jit.one_blas_thread():  # once per chunk, not once per short run
+        return [classify_point(base, dict(zip(columns, pt)), settings) for pt in points]
 
 
 # --------------------------------------------------------------------------- analytic thresholds
@@ -347,8 +349,9 @@ def _run_points(base, settings, columns, todo, pool, workers, on_rows, meanwhile
     while the workers compute (after them without a pool)."""
     if pool is None:
         warm_engine(settings)
-        for pt in todo:
-            on_rows([classify_point(base, dict(zip(columns, pt)), settings)])
+        with _jit.one_blas_thread():  # once for the batch, not once per short run
+            for pt in todo:
+                on_rows([classify_point(base, dict(zip(columns, pt)), settings)])
         if meanwhile is not None:
             meanwhile()
         return

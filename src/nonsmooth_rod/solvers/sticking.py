@@ -448,6 +448,7 @@ def coupled_components(indptr, indices, W, label):
     na = label.shape[0]
     label[:] = -1
     stack = np.empty(na, dtype=np.int64)
+    sparse = indptr.shape[0] > 0
     groups = 0
     for seed in range(na):
         if label[seed] >= 0:
@@ -458,7 +459,6 @@ def coupled_components(indptr, indices, W, label):
         while top > 0:
             top -= 1
             i = stack[top]
-            sparse = indptr.shape[0] > 0
             for k in range(indptr[i] if sparse else 0, indptr[i + 1] if sparse else na):
                 j = indices[k] if sparse else k
                 if label[j] < 0 and (sparse or W[2 * i, 2 * j] != 0.0 or W[2 * i, 2 * j + 1] != 0.0
@@ -508,6 +508,16 @@ def gather_contacts(members, x, pairs):
 
 
 @jit
+def scatter_contacts(members, p_group, u_group, states_group, p, u, states):
+    """Write a group's p, u (two entries per contact) and states back at its contacts."""
+    for a in range(members.shape[0]):
+        i = members[a]
+        p[2 * i], p[2 * i + 1] = p_group[2 * a], p_group[2 * a + 1]
+        u[2 * i], u[2 * i + 1] = u_group[2 * a], u_group[2 * a + 1]
+        states[i] = states_group[a]
+
+
+@jit
 def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
                              states, max_group):
     """prefer_sticking on each group of coupled contacts alone (coupled_components). The step's
@@ -519,6 +529,9 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
     na = mu_s.shape[0]
     label = np.empty(na, dtype=np.int64)
     groups = coupled_components(indptr, indices, W, label)
+    if groups == 1 and W.shape[0] > 0:  # one dense group (the common case): nothing to gather
+        return na <= max_group and prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
+                                                   states)
     changed = False
     for g in range(groups):
         members = np.flatnonzero(label == g)
@@ -527,18 +540,17 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
             wanted = wanted or (start_guess[i] == 0.0 and states[i] != STATE_STICK)
         if not wanted or members.shape[0] > max_group:
             continue
-        Wg = group_matrix(members, W, indptr, indices, blocks)
-        pg, ug, states_g = gather_contacts(members, p, True), gather_contacts(members, u, True), gather_contacts(members, states, False)
-        if prefer_sticking(Wg, gather_contacts(members, q, True), gather_contacts(members, mu_s, False),
-                           gather_contacts(members, mu_d, False), gather_contacts(members, start_guess, False), velocity_tol,
+        pg, ug = gather_contacts(members, p, True), gather_contacts(members, u, True)
+        states_g = gather_contacts(members, states, False)
+        if prefer_sticking(group_matrix(members, W, indptr, indices, blocks), gather_contacts(members, q, True),
+                           gather_contacts(members, mu_s, False), gather_contacts(members, mu_d, False),
+                           gather_contacts(members, start_guess, False), velocity_tol,
                            gather_contacts(members, closing, False), pg, ug, states_g):
-            for a in range(members.shape[0]):
-                i = members[a]
-                p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1] = pg[2 * a], pg[2 * a + 1], ug[2 * a], ug[2 * a + 1]
-                states[i] = states_g[a]
+            scatter_contacts(members, pg, ug, states_g, p, u, states)
             changed = True
     return changed
 
 
-__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK",
-           "STATE_SLIP_PLUS", "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE"]
+__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
+           "scatter_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK", "STATE_SLIP_PLUS",
+           "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE"]

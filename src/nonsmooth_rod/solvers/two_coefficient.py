@@ -32,7 +32,7 @@ from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER
                       lemke_interval, pgs_block, solve_enum, solve_interval, solve_lemke, solve_pgs)
 from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
-from .sticking import coupled_components, gather_contacts, group_matrix, prefer_sticking_by_group
+from .sticking import coupled_components, gather_contacts, group_matrix, prefer_sticking_by_group, scatter_contacts
 
 COMPILED_SOLVERS = SOLVER_CODES  # solver name -> code of the compiled kernels
 
@@ -138,19 +138,6 @@ MAX_DENSE_HOLD = 64
 
 
 @jit
-def _dense_of(indptr, indices, blocks, na):
-    """The dense W of solvers.kernels' block-sparse layout."""
-    W = np.zeros((2 * na, 2 * na))
-    for i in range(na):
-        for k in range(indptr[i], indptr[i + 1]):
-            j = indices[k]
-            for a in range(2):
-                for b in range(2):
-                    W[2 * i + a, 2 * j + b] = blocks[k, a, b]
-    return W
-
-
-@jit
 def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback):
     """pgs on the block-sparse W; with `fallback`, a step it cannot solve with at most
     MAX_DENSE_HOLD contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
@@ -161,9 +148,15 @@ def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallb
     na = lo.shape[0]
     if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
         return status, sweeps, residual, 0
-    W = _dense_of(indptr, indices, blocks, na)
+    W = group_matrix(np.arange(na), np.zeros((0, 0)), indptr, indices, blocks)  # the whole W, dense
     status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0)  # Lemke's own acceptance
     return status, sweeps + pivots, residual, 1
+
+
+@jit
+def _defaults(rtol, max_iter):
+    """pgs runs under its default settings: a user's own tol or max_iter has no Lemke behind it."""
+    return rtol <= 0.0 and max_iter <= 0
 
 
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
@@ -172,8 +165,8 @@ def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_i
 
     Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
     that solver (`_solve_compiled`); lemke and enum then take the dense W."""
-    if indptr.shape[0] > 0:  # pgs's own settings (tol, max_iter) given: no Lemke behind them
-        return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, rtol <= 0.0 and max_iter <= 0)
+    if indptr.shape[0] > 0:
+        return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter))
     status, iterations, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
     return status, iterations, residual, 0
 
@@ -197,7 +190,7 @@ if _jit.ENABLED:
             def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
                 if indptr.shape[0] > 0:
                     return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter,
-                                        rtol <= 0.0 and max_iter <= 0)
+                                        _defaults(rtol, max_iter))
                 status, iterations, residual = solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
                 return status, iterations, residual, 0
             return solve_pgs_either
@@ -313,10 +306,9 @@ def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, rest
             gather_contacts(members, resting, False), rtol, max_iter, pg, ug, states_g)
         solves, iterations, fallbacks = solves + n_solves, iterations + its, fallbacks + fell_back
         consistent = consistent and group_consistent
+        scatter_contacts(members, pg, ug, states_g, p, u, states)
         for a in range(members.shape[0]):
-            i = members[a]
-            p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1] = pg[2 * a], pg[2 * a + 1], ug[2 * a], ug[2 * a + 1]
-            states[i], guess[i] = states_g[a], guess_g[a]
+            guess[members[a]] = guess_g[a]
         if status != KERNEL_SOLVED:
             return status, solves, iterations, False, fallbacks
     return KERNEL_SOLVED, solves, iterations, consistent, fallbacks
@@ -369,5 +361,6 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                              float(sol.residual), consistent)
 
 
-__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_by_group", "StepContactResult", "classify_solution",
+__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_by_group", "StepContactResult",
+           "classify_solution",
            "next_action", "solve_interval", "SolverError", "STATE_NAMES"]
