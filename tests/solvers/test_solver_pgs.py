@@ -100,15 +100,41 @@ def test_pgs_runs_the_rod_through_ball_b_impact_like_lemke(mu_s, mu_d, theta0_de
 
 def test_stalled_residual_is_accepted_only_within_the_common_tolerance():
     """The stalled step of issue 9 in miniature: two corners of one body (W of rank 3) and
-    a q with a component outside range(W) of relative size 1e-11."""
+    a q with a component outside range(W) of relative size 1e-11.
+
+    Whether Gauss–Seidel stalls on it or finds an exact solution (one corner slipping at
+    ~1e-11 m/s) depends on the round-off of the BLAS build, so the test asserts the contract,
+    not the path: under the default settings the answer is within the common tolerance; under
+    an explicit tolerance the answer meets it or the solver raises — never anything between."""
     problem = block_on_incline(0.3, 0.5)  # both corners stick
     null = np.linalg.svd(problem.W)[2][-1]  # W's null vector: q along it is out of range
     stalled = PlanarFrictionProblem(problem.W, problem.q + 1e-11 * np.abs(problem.q).max() * null,
                                     problem.lo, problem.hi)
     solution = projected_gauss_seidel(stalled)
     scale = residual_scale(stalled, solution.p, solution.u)
-    assert 1e-13 * scale < complementarity_residual(stalled, solution.p) <= 1e-9 * scale
+    assert complementarity_residual(stalled, solution.p) <= 1e-9 * scale
     assert solution.iterations < 1000
-    # an explicit tolerance is a hard requirement: the residual cannot get there
-    with pytest.raises(NoConvergence, match="no convergence after 300 sweeps"):
-        projected_gauss_seidel(stalled, tol=1e-13, max_iter=300)
+    # an explicit tolerance is a hard requirement: met, or reported
+    try:
+        tight = projected_gauss_seidel(stalled, tol=1e-13, max_iter=300)
+    except NoConvergence as error:
+        assert "no convergence after 300 sweeps" in str(error)
+    else:
+        tight_scale = residual_scale(stalled, tight.p, tight.u)
+        assert tight.residual <= 1e-13 * tight_scale
+        assert complementarity_residual(stalled, tight.p) <= 1e-12 * tight_scale  # W p in numpy's order
+
+
+def test_explicit_tolerance_on_a_step_with_no_exact_solution_raises():
+    """A frictionless pair whose normal rows can never both be satisfied: w1 + w2 = −ε for
+    every p (W = g gᵀ, g = (1, −1)), so the best residual is ~ε/2 on any build. A tolerance
+    below it is never met: the solver must say so, not return the stalled iterate."""
+    eps = 1e-6
+    W = np.zeros((4, 4))
+    W[np.ix_([0, 2], [0, 2])] = [[1.0, -1.0], [-1.0, 1.0]]
+    W[1, 1] = W[3, 3] = 1.0
+    problem = PlanarFrictionProblem(W, [1.0, 0.0, -1.0 - eps, 0.0], [0.0, 0.0], [0.0, 0.0])
+    with pytest.raises(NoConvergence, match="no convergence after 200 sweeps"):
+        projected_gauss_seidel(problem, tol=1e-9, max_iter=200)
+    with pytest.raises(NoConvergence):  # nor under the defaults: ε/2 is far above their acceptance
+        projected_gauss_seidel(problem)
