@@ -126,7 +126,7 @@ def purge_stale_kernels() -> bool:
     return True
 
 
-__all__ = ["jit", "ENABLED", "one_blas_thread"]
+__all__ = ["jit", "ENABLED", "one_blas_thread", "compiling", "compile_in_background", "compile_policy"]
 
 
 # ---------------------------------------------------------------- BLAS threads
@@ -141,41 +141,69 @@ _blas_depth = 0  # nested uses (a sweep's batch around its runs) limit and resto
 
 class one_blas_thread:
     """Context manager: BLAS/LAPACK (numpy's and scipy's OpenBLAS, which numba's kernels call) on
-    one thread inside, the previous limits restored after. ~15–30 µs to enter once warm; nested
-    inside another, nearly free — so a sweep wraps its whole batch once, not each short run."""
+    one thread inside, the previous limits restored after. The libraries are looked up once per
+    process (threadpoolctl); entering then costs two ctypes calls per library (~1 µs), and nested
+    inside another use it is free — so a sweep wraps its whole batch once, not each short run."""
 
     def __enter__(self):
         global _blas, _blas_depth
-        self._limit = None
+        self._restore = ()
         _blas_depth += 1
         if _blas_depth > 1:
             return self
         if _blas is None:
-            try:
-                import scipy.linalg.cython_lapack  # noqa: F401  (the LAPACK numba's kernels call)
-                from threadpoolctl import ThreadpoolController
-            except ImportError:
-                _blas = False
-                return self
-            _blas = ThreadpoolController()
-        if _blas:
-            self._limit = _blas.limit(limits=1, user_api="blas")
+            _blas = _blas_libraries()
+        restore = []
+        for library in _blas:
+            threads = library.num_threads
+            if threads != 1:
+                library.set_num_threads(1)
+                restore.append((library, threads))
+        self._restore = restore
         return self
 
     def __exit__(self, exc_type, exc, tb):
         global _blas_depth
         _blas_depth -= 1
-        if self._limit is not None:
-            self._limit.restore_original_limits()
+        for library, threads in self._restore:
+            library.set_num_threads(threads)
         return False
 
 
-# ---------------------------------------------------------------- saying when we compile
-# The first compiled run on a fresh install compiles the engine (seconds); later processes load
-# it from the cache. A marker next to the cache records that compiling has happened for this
-# version, so the CLI can say "compiling the engine, once" only when it really will.
-COMPILE_ESTIMATE_S = 45  # benchmarks/bench_startup.py: 46.8 s cold (lemke, rod) on the 2 shared cores at load 2.5
+def _blas_libraries() -> list:
+    """threadpoolctl's controllers of the loaded BLAS libraries ([] without threadpoolctl)."""
+    try:
+        import scipy.linalg.cython_lapack  # noqa: F401  (the LAPACK numba's kernels call)
+        from threadpoolctl import ThreadpoolController
+    except ImportError:
+        return []
+    return list(ThreadpoolController().select(user_api="blas").lib_controllers)
+
+
+# ---------------------------------------------------------------- when to compile
+# Compiling a solver's loop costs ~1 min of CPU on a fresh install (benchmarks/bench_startup.py),
+# far more than most first runs take interpreted (the same source, ~30x slower per step). So no
+# run waits for the compiler longer than it would take to run without it: a run whose cache is
+# cold starts interpreted, measures its own per-step cost on a few steps, and
+#   * when the rest of it takes less than compiling would, goes on interpreted while a detached
+#     process compiles that solver's loop into the on-disk cache for later runs ("background");
+#   * otherwise compiles now (saying so once, with the time measured on this machine) and goes on
+#     compiled from the step it reached.
+# NONSMOOTH_ROD_COMPILE=wait makes every cold compiled run compile in-process first (the test
+# suite and `nonsmooth-rod compile` use it, so what they measure is the compiled engine).
+# A marker next to the cache records that a part (one solver's loop, or its step-wise entry) is
+# compiled for this version of the sources; a file lock makes sure that only one process at a
+# time compiles a part, so two workers starting together never compile the same kernels twice.
+COMPILE_ESTIMATE_S = 60.0  # before any measurement here: 55 s CPU cold (lemke loop) on the 2-core machine
+POLICIES = ("auto", "wait")
 _notifier = None
+_noticed: set = set()
+_warm: set = set()  # parts known warm in this process: no filesystem check per call
+
+
+def compile_policy() -> str:
+    policy = os.environ.get("NONSMOOTH_ROD_COMPILE", "auto").strip().lower() or "auto"
+    return policy if policy in POLICIES else "auto"
 
 
 def _marker(part: str = "engine") -> Path:
@@ -186,39 +214,134 @@ def _marker(part: str = "engine") -> Path:
 
 
 def engine_is_warm(part: str = "engine") -> bool:
-    """True when the engine's compiled kernels are (very likely) in the on-disk cache."""
-    return not ENABLED or _marker(part).exists()
+    """True when the part's compiled kernels are (very likely) in the on-disk cache."""
+    if not ENABLED or part in _warm:
+        return True
+    if _marker(part).exists():
+        _warm.add(part)
+        return True
+    return False
+
+
+def compile_estimate_s(part: str) -> tuple[float, bool]:
+    """(seconds, measured): the last compile time of `part` measured on this machine, or the
+    default estimate when it was never compiled here."""
+    try:
+        return float(_marker(part).with_suffix(".seconds").read_text()), True
+    except (OSError, ValueError):
+        return COMPILE_ESTIMATE_S, False
+
+
+def _record_compiled(part: str, seconds: float | None) -> None:
+    try:
+        marker = _marker(part)
+        marker.parent.mkdir(parents=True, exist_ok=True)
+        if seconds is not None:
+            marker.with_suffix(".seconds").write_text(f"{seconds:.3f}\n")
+        marker.touch()
+        _warm.add(part)
+    except OSError:
+        pass  # a read-only cache: numba could not write there either
 
 
 def set_compile_notifier(notify) -> None:
-    """`notify(message)` is called once, before a compile that will take a while (the CLI prints it)."""
+    """`notify(message)` is called once per part and process, before a compile that takes a while,
+    and when a run goes on interpreted while the compile happens in the background (the CLI prints it)."""
     global _notifier
     _notifier = notify
 
 
-class compiling_notice:
-    """Context manager around a compiled run: says once that compiling happens, marks it done."""
+def _say(key: str, message: str) -> None:
+    if key in _noticed:
+        return
+    _noticed.add(key)
+    import logging
 
-    def __init__(self, active: bool = True, part: str = "engine"):
-        self.active = active
-        self.part = part  # each solver's loop compiles on its first use: one marker each
+    logging.getLogger("nonsmooth_rod").info(message)
+    if _notifier is not None:
+        _notifier(message)
+
+
+class _part_lock:
+    """An exclusive lock on compiling `part` (fcntl.flock on a file next to the marker; released
+    with the process if it dies). blocking=False: `acquired` says whether it was taken."""
+
+    def __init__(self, part: str, blocking: bool = True):
+        self.path, self.blocking, self.acquired, self._file = _marker(part).with_suffix(".lock"), blocking, False, None
 
     def __enter__(self):
-        self.cold = self.active and not engine_is_warm(self.part)
-        if self.cold:
-            import logging
+        try:
+            import fcntl
 
-            message = f"compiling the engine, once: ~{COMPILE_ESTIMATE_S} s"
-            logging.getLogger("nonsmooth_rod").info(message)
-            if _notifier is not None:
-                _notifier(message)
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._file = open(self.path, "a")
+            fcntl.flock(self._file, fcntl.LOCK_EX | (0 if self.blocking else fcntl.LOCK_NB))
+            self.acquired = True
+        except (ImportError, OSError):
+            self.acquired = self.blocking  # no locking here (read-only cache, no fcntl): go on alone
         return self
 
     def __exit__(self, exc_type, exc, tb):
-        if self.cold and exc_type is None:
-            try:
-                _marker(self.part).parent.mkdir(parents=True, exist_ok=True)
-                _marker(self.part).touch()
-            except OSError:
-                pass
+        if self._file is not None:
+            self._file.close()  # releases the lock; the file stays, so the lock is never held twice
         return False
+
+
+class compiling:
+    """Context manager around the first compiled call of `part` in a process: when the part is cold,
+    says once what is compiled and how long it takes here, waits for any other process compiling it,
+    and afterwards marks the part compiled with the time it took."""
+
+    def __init__(self, part: str, what: str):
+        self.part, self.what = part, what
+
+    def __enter__(self):
+        self.cold = ENABLED and not engine_is_warm(self.part)
+        if not self.cold:
+            return self
+        import time
+
+        self._lock = _part_lock(self.part).__enter__()
+        if engine_is_warm(self.part):  # another process compiled it while we waited
+            self.cold = False
+            return self
+        seconds, measured = compile_estimate_s(self.part)
+        _say(self.part, f"compiling {self.what} (once per install): ~{seconds:.0f} s "
+                        f"{'as measured on this machine' if measured else 'estimated'}")
+        self._start = time.perf_counter()
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if self.cold:
+            import time
+
+            if exc_type is None:
+                _record_compiled(self.part, time.perf_counter() - self._start)
+            self._lock.__exit__(exc_type, exc, tb)
+        elif hasattr(self, "_lock"):
+            self._lock.__exit__(exc_type, exc, tb)
+        return False
+
+
+def compile_in_background(part: str, args: list[str], what: str, seconds: float) -> bool:
+    """Start a detached process that compiles `part` (python -m nonsmooth_rod._compile_job ARGS)
+    unless one is already at it; says once that the run goes on interpreted. True if started."""
+    import subprocess
+    import sys
+
+    with _part_lock(part, blocking=False) as lock:
+        if not lock.acquired:
+            return False  # some process is compiling it now
+    log = _marker(part).with_suffix(".log")
+    try:
+        log.parent.mkdir(parents=True, exist_ok=True)
+        with open(log, "w") as out:
+            job = subprocess.Popen([sys.executable, "-m", "nonsmooth_rod._compile_job", *args],
+                                   stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
+                                   start_new_session=True, close_fds=True)
+        _marker(part).with_suffix(".pid").write_text(f"{job.pid}\n")
+    except OSError:
+        return False
+    _say(part + ":background", f"running interpreted: this run is shorter than compiling {what} "
+                               f"(~{seconds:.0f} s), which goes on in the background for later runs")
+    return True

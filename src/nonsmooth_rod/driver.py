@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._jit import compiling_notice
 from .integrators import METHODS, integrator_classes, supported_contacts
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
@@ -58,9 +57,7 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     opts = _options(options_cls, method, options, impact_stops)
     _check_output_size(method, opts, scene, t_end - t0, save_every)
     run_scene = _shifted(scene, t0)
-    compiled = method == "moreau-jean" and opts.fast and opts.solver in ("lemke", "pgs", "enum")
-    with compiling_notice(active=compiled, part=f"moreau-jean-{getattr(opts, 'solver', '')}"):
-        result = integrator_cls(opts).run(run_scene, q0, v0, t_end - t0)
+    result = integrator_cls(opts).run(run_scene, q0, v0, t_end - t0)
     result.method = method
     if t0:
         _shift_times(result, t0)

@@ -16,6 +16,8 @@ def test_bench_startup_quick_runs(capsys):
     assert module.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert [line.split()[1] for line in out.splitlines() if line.startswith("import ")] == list(module.ENTRY_POINTS)
+    cold = [line for line in out.splitlines() if line.startswith("first run, empty cache:")]
+    assert len(cold) == 1 and ("interpreted" in cold[0] or "compiled" in cold[0])
     ratios = [float(line.split()[-1]) for line in out.splitlines() if line.startswith("rod h=")]
     assert len(ratios) == 2 and all(r >= 1.0 for r in ratios)  # the whole call contains the integrator
 

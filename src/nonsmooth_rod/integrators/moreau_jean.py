@@ -15,6 +15,7 @@ nonsmooth solutions and, with e = 0 and θ = ½, dissipative (energy never grows
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -103,6 +104,21 @@ def _allocate(packed, q0, v0, n_steps):
     return model, work, out
 
 
+# Steps run interpreted to measure a cold run's per-step cost before deciding whether to compile.
+PROBE_STEPS = 16
+
+
+def compiled_part(solver: str, solver_code, callback: bool):
+    """(cache part, what it is in words, background job's arguments) of the compiled entry a run uses."""
+    if solver_code is None:
+        return ("moreau-jean-python-step", "the step kernels around Python solvers",
+                ["--python-step", solver])
+    if callback:
+        return (f"moreau-jean-{solver}-step", f"the {solver} step-wise loop (Python force callback)",
+                ["--step", solver])
+    return f"moreau-jean-{solver}", f"the Moreau–Jean loop with solver {solver}", [solver]
+
+
 class MoreauJean:
     """The Moreau–Jean one-step integrator over a Scene (one loop: moreau_jean_loop)."""
 
@@ -127,22 +143,53 @@ class MoreauJean:
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
                             names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1],
                            dtype=np.int64)
-        compiled = bool(opts.fast and _jit.ENABLED)
-        kernels = loop_kernels(compiled)
         callback = scene.applied_force is not None
         self._solver_error = None
         wall = time.process_time()
         with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
-            if not callback and solver_code is not None:
-                getattr(kernels, loop.RUN_STEPS[solver_code])(0, n_steps, params, iparams, model, work, out)
-            else:
-                self._run_stepwise(kernels, scene, n_steps, params, iparams, model, work, out)
+            compiled = self._run_loop(scene, n_steps, solver_code, params, iparams, model, work, out)
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": compiled and solver_code is not None, "force_callback": callback}
         return self._result(scene, packed, out, names, t_end, cpu, stats)
 
-    def _run_stepwise(self, kernels, scene, n_steps, params, iparams, model, work, out):
+    def _run_loop(self, scene, n_steps, solver_code, params, iparams, model, work, out) -> bool:
+        """Steps 0 … n_steps − 1, compiled when it pays (_jit: no run waits for the compiler
+        longer than it would run without it); True if they ran compiled."""
+        compiled = bool(self.options.fast and _jit.ENABLED)
+        part, what, job = compiled_part(self.options.solver, solver_code, scene.applied_force is not None)
+        done = 0
+        if compiled and not _jit.engine_is_warm(part) and _jit.compile_policy() == "auto":
+            done, compiled = self._probe_interpreted(part, what, job, scene, n_steps, solver_code, params,
+                                                     iparams, model, work, out)
+        if done < n_steps and out[9][loop.K_STATUS] == loop.RUN_OK:
+            with _jit.compiling(part, what) if compiled else contextlib.nullcontext():
+                self._advance(loop_kernels(compiled), scene, done, n_steps, solver_code, params, iparams,
+                              model, work, out)
+        return compiled
+
+    def _probe_interpreted(self, part, what, job, scene, n_steps, solver_code, params, iparams, model, work,
+                           out):
+        """A cold compiled part: time the first steps interpreted, then (steps done, compile now?):
+        go on interpreted — compiling in the background — when the rest is shorter than compiling."""
+        probe = min(n_steps, PROBE_STEPS)
+        start = time.perf_counter()
+        self._advance(loop_kernels(False), scene, 0, probe, solver_code, params, iparams, model, work, out)
+        rest = (time.perf_counter() - start) / probe * (n_steps - probe)
+        compile_s, _ = _jit.compile_estimate_s(part)
+        if rest <= compile_s or out[9][loop.K_STATUS] != loop.RUN_OK:
+            _jit.compile_in_background(part, job, what, compile_s)
+            return probe, False
+        return probe, True
+
+    def _advance(self, kernels, scene, k_start, k_end, solver_code, params, iparams, model, work, out):
+        """Steps k_start … k_end − 1 with the given kernels (compiled, or their interpreted twins)."""
+        if scene.applied_force is None and solver_code is not None:
+            getattr(kernels, loop.RUN_STEPS[solver_code])(k_start, k_end, params, iparams, model, work, out)
+        else:
+            self._run_stepwise(kernels, scene, k_start, k_end, params, iparams, model, work, out)
+
+    def _run_stepwise(self, kernels, scene, k_start, k_end, params, iparams, model, work, out):
         """The loop step by step from Python: for a Python `applied_force` (called back for each
         step's force) and for the Python (QP) solvers."""
         q, v, counters = out[0], out[1], out[9]
@@ -150,7 +197,7 @@ class MoreauJean:
         f = np.empty(scene.n_dof)
         solver_code = int(iparams[loop.I_SOLVER])
         compiled_step = getattr(kernels, loop.COMPILED_STEP[solver_code]) if solver_code >= 0 else None
-        for k in range(n_steps):
+        for k in range(k_start, k_end):
             kernels.step_force(k, params, model, out, f)
             if scene.applied_force is not None:
                 f += scene.applied((k + th) * h, q[k], v[k])
@@ -323,8 +370,9 @@ def located_phases(scene, out, packed, impacts, n_done, h, min_phase, t_stop):
     impact_time = {(imp.contact, int(round(imp.t / h))): imp.t for imp in impacts}
     for i, name in enumerate(names):
         codes = out[5][:n_done, i]
-        starts = np.r_[0, np.flatnonzero(codes[1:] != codes[:-1]) + 1]  # runs of one state
-        found = phases_from_intervals(np.r_[bounds[starts], bounds[-1]], [STATE_NAMES[c] for c in codes[starts]],
+        starts = np.flatnonzero(codes[1:] != codes[:-1]) + 1  # runs of one state
+        starts = np.concatenate((np.zeros(1, dtype=starts.dtype), starts))
+        found = phases_from_intervals(np.append(bounds[starts], bounds[-1]), [STATE_NAMES[c] for c in codes[starts]],
                                       min_phase)
         for before, after in zip(found, found[1:]):
             k = int(round(after.t_start / h))
