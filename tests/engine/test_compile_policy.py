@@ -17,10 +17,11 @@ pytestmark = pytest.mark.skipif(not _jit.ENABLED, reason="numba not installed")
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _cold_run(monkeypatch, compile_seconds, t_end=0.05):
+def _cold_run(monkeypatch, tmp_path, compile_seconds, t_end=0.05):
     """A block-on-incline run whose loop is taken as cold, with the given compile estimate;
-    returns (result, background jobs asked for)."""
+    returns (result, background jobs asked for). Markers and locks go to tmp_path."""
     monkeypatch.setenv("NONSMOOTH_ROD_COMPILE", "auto")
+    monkeypatch.setattr(_jit, "_marker", lambda part="engine": tmp_path / f"{part}.marker")
     monkeypatch.setattr(_jit, "_warm", set())
     monkeypatch.setattr(_jit, "engine_is_warm", lambda part="engine": False)
     monkeypatch.setattr(_jit, "compile_estimate_s", lambda part: (compile_seconds, True))
@@ -31,8 +32,8 @@ def _cold_run(monkeypatch, compile_seconds, t_end=0.05):
     return nr.simulate(toy.scene(), q0, v0, t_end, method="moreau-jean", h=1e-3, solver="lemke"), started
 
 
-def test_a_run_shorter_than_compiling_goes_on_interpreted_and_compiles_in_background(monkeypatch):
-    run, started = _cold_run(monkeypatch, compile_seconds=1e9)
+def test_a_run_shorter_than_compiling_goes_on_interpreted_and_compiles_in_background(monkeypatch, tmp_path):
+    run, started = _cold_run(monkeypatch, tmp_path, compile_seconds=1e9)
     assert run.status == "ok" and not run.stats["compiled"]
     assert [args[0] for args in started] == ["moreau-jean-lemke"]
     toy = BlockOnIncline(angle=math.radians(25.0), mu_s=0.3, mu_d=0.2)  # tan 25° > μs: it slides
@@ -40,8 +41,8 @@ def test_a_run_shorter_than_compiling_goes_on_interpreted_and_compiles_in_backgr
     assert velocity[-1] == pytest.approx(toy.slope_velocity(run.trajectory.t[-1]), rel=1e-9)
 
 
-def test_a_run_longer_than_compiling_compiles_now_and_goes_on_compiled(monkeypatch):
-    run, started = _cold_run(monkeypatch, compile_seconds=0.0)
+def test_a_run_longer_than_compiling_compiles_now_and_goes_on_compiled(monkeypatch, tmp_path):
+    run, started = _cold_run(monkeypatch, tmp_path, compile_seconds=0.0)
     assert run.status == "ok" and run.stats["compiled"] and started == []
 
 
