@@ -5,11 +5,16 @@
 Scenes: the paper's rod, each toy, a frictionless ladder (2 contacts, 1 body), a row of N balls
 on a floor (N − 1 disk–disk and N disk–floor contacts, the first ball rolling into the others),
 and a pyramid pile of disks on a floor — with lemke and pgs (lemke only up to 32 contacts: its
-dense tableau grows as contacts³). Each run is timed whole (CPU time / steps, median of the
-repeats) next to the yardstick, one 3×3 numpy.linalg.solve in a Python loop, timed again just
+dense tableau grows as contacts³). Each run is timed whole, through `nr.simulate` (CPU time of
+the call / steps, median of the repeats; the loop's own share, `result.cpu_time_s`, beside it),
+next to the yardstick, one 3×3 numpy.linalg.solve in a Python loop, timed again just
 before each scene (the shared machine's speed drifts within a run); ratios are what to read.
 MuJoCo (mj_step) steps the ball rows and the pile when `mujoco` is installed (optional extra
 `bench`); PyBullet likewise when `pybullet` is.
+
+Issue 25's targets, per step through `nr.simulate`: the paper's rod ≤ 0.3 yardsticks at
+h = 1e-4, one-contact toys ≤ 0.2, two-contact toys ≤ 0.4; and a 50-step run's whole call
+≤ 1.2× its loop (the section "targets" below the table).
 
 The cold compile time is a subprocess with an empty NUMBA_CACHE_DIR running one short rod run
 (issue 16's target: ≤ 5 s on an idle 2-core machine).
@@ -28,9 +33,9 @@ from pathlib import Path
 
 import numpy as np
 
+import nonsmooth_rod as nr
 from nonsmooth_rod import toys
 from nonsmooth_rod.toys import stacks
-from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import Line, PointOnLine
 from nonsmooth_rod.model.laws import ContactLaw
@@ -85,16 +90,39 @@ def other_engines_us(name, q0, h, steps, repeats):
 
 
 def step_us(scene, q0, v0, solver, h, steps, repeats):
-    options = MoreauJeanOptions(h=h, solver=solver)
-    run = MoreauJean(options).run(scene, q0, v0, h * steps)  # warm-up: compiles on first use
+    """(whole call, loop) µs per step of `nr.simulate` (medians of the repeats), and the last run."""
+    run = nr.simulate(scene, q0, v0, h * steps, method="moreau-jean", h=h, solver=solver)  # compiles on first use
     if run.status != "ok":
-        return math.nan, run
-    times = []
+        return math.nan, math.nan, run
+    whole, loop = [], []
     for _ in range(repeats):
         t0 = time.process_time()
-        run = MoreauJean(options).run(scene, q0, v0, h * steps)
-        times.append((time.process_time() - t0) / run.steps * 1e6)
-    return statistics.median(times), run
+        run = nr.simulate(scene, q0, v0, h * steps, method="moreau-jean", h=h, solver=solver)
+        whole.append((time.process_time() - t0) / run.steps * 1e6)
+        loop.append(run.cpu_time_s / run.steps * 1e6)
+    return statistics.median(whole), statistics.median(loop), run
+
+
+ONE_CONTACT = ("BouncingBall", "DiskOnIncline", "PainleveRod")
+TWO_CONTACTS = ("BlockOnIncline", "PushedBlock", "BeltOscillator", "RockingBlock")
+
+
+def targets(repeats: int, quick: bool) -> None:
+    """Issue 25's per-step targets through nr.simulate, and whole/loop of 50-step runs."""
+    rod = RodProblem.paper(2)
+    cases = [("rod, h = 1e-4", rod.scene(), *rod.initial_state(), 1e-4, 500 if quick else 4000, 0.3)]
+    for name in ONE_CONTACT + TWO_CONTACTS:
+        toy = getattr(toys, name)()
+        cases.append((f"toy {name}", toy.scene(), *toy.initial_state(), 1e-3, 200 if quick else 500,
+                      0.2 if name in ONE_CONTACT else 0.4))
+    print(f"{'targets (issue 25)':28s} {'solver':>6s} {'whole x yd':>10s} {'target':>6s} {'50 steps whole/loop':>20s}")
+    for name, scene, q0, v0, h, steps, target in cases:
+        yard = yardstick_us(n=5000, repeats=3)
+        for solver in ("lemke", "pgs"):
+            whole, _, run = step_us(scene, q0, v0, solver, h, steps, repeats)
+            short_whole, short_loop, _ = step_us(scene, q0, v0, solver, h, 50, max(repeats, 5))
+            print(f"{name:28s} {solver:>6s} {whole / yard:10.2f} {target:6.1f} {short_whole / short_loop:20.2f}"
+                  f"{'' if run.status == 'ok' else '  ' + run.status}")
 
 
 def cold_compile_seconds() -> float:
@@ -106,6 +134,7 @@ def cold_compile_seconds() -> float:
             "MoreauJean(MoreauJeanOptions(h=1e-2)).run(p.scene(), q0, v0, 0.05)")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.join(os.path.dirname(__file__), "..", "src"),
                                                          os.environ.get("PYTHONPATH", "")]))
+    env["NONSMOOTH_ROD_COMPILE"] = "wait"  # the compile itself, not a run that goes on interpreted
     with tempfile.TemporaryDirectory() as cache:
         env["NUMBA_CACHE_DIR"] = cache
         walls = []
@@ -150,7 +179,7 @@ def main(argv=None) -> int:
     max_balls = args.max_balls or (32 if args.quick else 256)
     h, steps = 1e-3, (50 if args.quick else 500)
     yards = []  # the yardstick again before each scene: the shared machine's speed drifts in a run
-    print(f"{'scene':28s} {'contacts':>8s} {'solver':>6s} {'us/step':>10s} {'x yardstick':>11s}  compiled")
+    print(f"{'scene':28s} {'contacts':>8s} {'solver':>6s} {'us/step':>10s} {'x yardstick':>11s} {'loop x yd':>9s}  compiled")
     for name, (scene, q0, v0) in scenes(max_balls, args.quick):
         if args.only not in name:
             continue
@@ -160,9 +189,10 @@ def main(argv=None) -> int:
         for solver in ("lemke", "pgs"):
             if solver == "lemke" and nc > LEMKE_MAX_CONTACTS:
                 continue
-            us, run = step_us(scene, q0, v0, solver, h, steps, repeats)
+            us, loop_us, run = step_us(scene, q0, v0, solver, h, steps, repeats)
             note = "" if run.status == "ok" else f"  {run.status}: {run.message[:60]}"
-            print(f"{name:28s} {nc:8d} {solver:>6s} {us:10.1f} {us / yard:11.2f}  {run.stats['compiled']}{note}")
+            print(f"{name:28s} {nc:8d} {solver:>6s} {us:10.1f} {us / yard:11.2f} {loop_us / yard:9.2f}  "
+                  f"{run.stats['compiled']}{note}")
             if name.startswith("ball row"):
                 rows_cost.setdefault(solver, []).append((len(scene.bodies), us / yard))
         for engine, cost in other_engines_us(name, q0, h, steps, repeats):
@@ -174,6 +204,8 @@ def main(argv=None) -> int:
           f"{min(yards, default=yard):.2f}-{max(yards, default=yard):.2f}")
     if args.plot:
         plot_rows(rows_cost, args.plot)
+    if not args.only:
+        targets(repeats, args.quick)
     if not args.no_compile_time:
         cold, warm = cold_compile_seconds()
         print(f"first run, empty numba cache: {cold:.1f} s ({cold * 1e6 / yard:.2g} yardsticks); "

@@ -36,3 +36,13 @@ def test_bench_moreau_jean_quick_labels_compiled_and_interpreted_rows(capsys):
     assert labels == [f"{s} (compiled)" for s in ("lemke", "pgs", "enum")] + \
         [f"{s} (interpreted)" for s in ("lemke", "pgs", "enum")]
     assert all("FAILED" not in " ".join(row) and int(row[-1]) > 0 for row in rows)  # every run reached B's impact
+
+
+def test_bench_scenes_targets_quick_print_every_case(capsys):
+    module = _bench_scenes()
+    module.targets(1, quick=True)
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert len(rows) == 2 * (1 + len(module.ONE_CONTACT) + len(module.TWO_CONTACTS))
+    for row in rows:
+        whole, target, whole_over_loop = float(row[-3]), float(row[-2]), float(row[-1])
+        assert whole > 0 and target in (0.2, 0.3, 0.4) and whole_over_loop >= 1.0  # the call contains its loop
