@@ -1,8 +1,10 @@
 """Compile parts of the Moreau–Jean engine into numba's on-disk cache.
 
-`python -m nonsmooth_rod._compile_job SOLVER [SOLVER ...] [--step]` is what a cold run starts
-in the background (`_jit.compile_in_background`); `nonsmooth-rod compile` calls `warm_up` for
-every solver and both entries. Each part compiles under its lock and is marked when done.
+`python -m nonsmooth_rod._compile_job [--step]` (the whole-run loop, or the step-wise loop for
+Python force callbacks; every exact solver is compiled into each) and
+`python -m nonsmooth_rod._compile_job --python-step SOLVER` (the step kernels around a Python
+solver) are what a cold run starts in the background (`_jit.compile_in_background`);
+`nonsmooth-rod compile` calls `warm_up`. Each part compiles under its lock and is marked when done.
 """
 from __future__ import annotations
 
@@ -32,9 +34,10 @@ def _no_force(t, q, v):
     return np.zeros(6)
 
 
-def warm_up(solvers, loop: bool = True, step: bool = False) -> float:
-    """Compile each solver's whole-run loop (`loop`) and its step-wise entry for Python force
-    callbacks (`step`) by running a tiny scene with it; returns the seconds it took."""
+def warm_up(solvers=("lemke",), loop: bool = True, step: bool = False) -> float:
+    """Compile the whole-run loop (`loop`) and the step-wise loop for Python force callbacks
+    (`step`) by running a tiny scene with each solver (the first compiles, the others load or are
+    already there); returns the seconds it took."""
     previous = os.environ.get("NONSMOOTH_ROD_COMPILE")
     os.environ["NONSMOOTH_ROD_COMPILE"] = "wait"  # compile here and now, not in yet another process
     try:
@@ -78,8 +81,8 @@ def main(argv=None) -> int:
         os.nice(5)  # the user's interpreted run goes first on a busy machine
     except (AttributeError, OSError):
         pass
-    seconds = warm_up(solvers, loop=not step, step=step)
-    print(f"compiled {', '.join(solvers)}{' (step-wise entries)' if step else ''} in {seconds:.1f} s", flush=True)
+    seconds = warm_up(loop=not step, step=step)
+    print(f"compiled the {'step-wise' if step else 'whole-run'} Moreau–Jean loop in {seconds:.1f} s", flush=True)
     return 0
 
 

@@ -72,8 +72,7 @@ class MoreauJeanOptions:
             raise InputError(f"min_phase must be non-negative, got {self.min_phase!r}")
 
 
-_ENTRY_POINTS = ("run_steps_lemke", "run_steps_pgs", "run_steps_enum", "compiled_step_lemke",
-                 "compiled_step_pgs", "compiled_step_enum", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
+_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
 
 
 def loop_kernels(compiled: bool):
@@ -109,14 +108,14 @@ PROBE_STEPS = 16
 
 
 def compiled_part(solver: str, solver_code, callback: bool):
-    """(cache part, what it is in words, background job's arguments) of the compiled entry a run uses."""
+    """(cache part, what it is in words, background job's arguments) of the compiled entry a run
+    uses: the whole-run loop, the step-wise loop (Python force callbacks), or the step kernels
+    around a Python (QP) solver. The exact solvers share each compiled loop."""
     if solver_code is None:
-        return ("moreau-jean-python-step", "the step kernels around Python solvers",
-                ["--python-step", solver])
+        return "moreau-jean-python-step", "the step kernels around Python solvers", ["--python-step", solver]
     if callback:
-        return (f"moreau-jean-{solver}-step", f"the {solver} step-wise loop (Python force callback)",
-                ["--step", solver])
-    return f"moreau-jean-{solver}", f"the Moreau–Jean loop with solver {solver}", [solver]
+        return "moreau-jean-step", "the step-wise Moreau–Jean loop (Python force callback)", ["--step"]
+    return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []
 
 
 class MoreauJean:
@@ -185,7 +184,7 @@ class MoreauJean:
     def _advance(self, kernels, scene, k_start, k_end, solver_code, params, iparams, model, work, out):
         """Steps k_start … k_end − 1 with the given kernels (compiled, or their interpreted twins)."""
         if scene.applied_force is None and solver_code is not None:
-            getattr(kernels, loop.RUN_STEPS[solver_code])(k_start, k_end, params, iparams, model, work, out)
+            kernels.run_steps(k_start, k_end, params, iparams, model, work, out)
         else:
             self._run_stepwise(kernels, scene, k_start, k_end, params, iparams, model, work, out)
 
@@ -196,7 +195,7 @@ class MoreauJean:
         h, th = params[loop.P_H], params[loop.P_THETA]
         f = np.empty(scene.n_dof)
         solver_code = int(iparams[loop.I_SOLVER])
-        compiled_step = getattr(kernels, loop.COMPILED_STEP[solver_code]) if solver_code >= 0 else None
+        compiled_step = kernels.compiled_step if solver_code >= 0 else None
         for k in range(k_start, k_end):
             kernels.step_force(k, params, model, out, f)
             if scene.applied_force is not None:
