@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,6 +63,9 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     with compiling_notice(active=compiled, part=f"moreau-jean-{getattr(opts, 'solver', '')}"):
         result = integrator_cls(opts).run(run_scene, q0, v0, t_end - t0)
     result.method = method
+    # What the run was asked for, by the caller's names: saved results describe it (result_files).
+    result.run_inputs = {"scene": scene, "q0": q0, "v0": v0, "t0": t0, "t_end": t_end,
+                         "options": dict(options), "save_every": save_every, "stop": stop}
     if t0:
         _shift_times(result, t0)
     if callables:
@@ -152,8 +156,20 @@ def _force_shifted(force, t0: float):
     return force
 
 
+_TIME_IN_MESSAGE = re.compile(r"\b(t|t_end) = ([-+0-9.eE]+) s\b")
+
+
+def _shifted_time(match, t0: float) -> str:
+    try:
+        return f"{match[1]} = {float(match[2]) + t0:.12g} s"
+    except ValueError:
+        return match[0]
+
+
 def _shift_times(result: SimulationResult, t0: float) -> None:
     result.trajectory.t = result.trajectory.t + t0
+    # The integrators ran on a clock starting at 0: their messages' "t = … s" too.
+    result.message = _TIME_IN_MESSAGE.sub(lambda m: _shifted_time(m, t0), result.message)
     for event in result.events:
         event.t += t0
     for impact in result.impacts:
