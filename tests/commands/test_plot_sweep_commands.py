@@ -265,6 +265,8 @@ def _killed_at_the_fourth_point(base, settings, columns, chunk):
 
 
 def test_a_killed_sweep_worker_ends_the_sweep_in_one_line_and_resume_finishes_it(tmp_path, capsys, monkeypatch):
+    import fcntl
+
     from nonsmooth_rod.rod import regime
 
     clean, out = tmp_path / "clean", tmp_path / "killed"
@@ -273,6 +275,9 @@ def test_a_killed_sweep_worker_ends_the_sweep_in_one_line_and_resume_finishes_it
     assert main(SMALL_SWEEP + ["--jobs", "2", "--out", str(out)]) == 1
     err = _one_line(capsys)
     assert err.startswith("nonsmooth-rod: a worker process died") and "run the same sweep again to resume" in err
+    with open(out / ".sweep.lock", "a") as lock:  # free at once: no surviving worker holds it
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(lock, fcntl.LOCK_UN)
     monkeypatch.undo()
     assert main(SMALL_SWEEP + ["--jobs", "2", "--out", str(out)]) == 0
     assert _sweep_table(out) == _sweep_table(clean)

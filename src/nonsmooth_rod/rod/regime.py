@@ -273,6 +273,27 @@ def _prepare_folder(out_dir: Path, record: dict, columns) -> list[dict]:
     return rows
 
 
+# flock belongs to the open file, which a fork shares: the local pool's workers, forked while the
+# sweep holds its folder's lock, would hold it too, and one still finishing its chunk after the
+# sweep stopped (a worker killed, Ctrl-C) would refuse the rerun. Each child drops it at once.
+_HELD_LOCKS: set[int] = set()
+
+
+def _drop_locks_in_child() -> None:
+    if not _HELD_LOCKS:
+        return
+    null = os.open(os.devnull, os.O_RDONLY)
+    for fd in _HELD_LOCKS:  # dup2, not close: the number stays valid for the file object that owns it
+        with contextlib.suppress(OSError):
+            os.dup2(null, fd)
+    os.close(null)
+    _HELD_LOCKS.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_drop_locks_in_child)
+
+
 @contextlib.contextmanager
 def folder_lock(out_dir: Path):
     """Refuse a second sweep writing into the same folder at the same time (their appends
@@ -295,9 +316,11 @@ def folder_lock(out_dir: Path):
         fh.close()
         raise InputError(f"another sweep is writing to {out_dir} (it holds {path}): wait for it or use "
                          "another --out") from None
+    _HELD_LOCKS.add(fh.fileno())
     try:
         yield
     finally:
+        _HELD_LOCKS.discard(fh.fileno())
         fh.close()
 
 
