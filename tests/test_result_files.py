@@ -49,7 +49,7 @@ def test_a_folder_mixed_by_a_killed_run_is_refused_in_one_line(tmp_path):
     assert len(ids) == 2 and all(len(i) == 32 for i in ids)
     load(first)  # consistent: loads
     (first / "trajectory.csv").write_bytes((second / "trajectory.csv").read_bytes())
-    with pytest.raises(InputError, match=r"mixed results: trajectory.csv is not the file summary.json describes") as err:
+    with pytest.raises(InputError, match=r"mixed results: trajectory.csv is not the file summary.json") as err:
         load(first)
     assert "\n" not in str(err.value)
 
