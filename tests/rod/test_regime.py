@@ -394,7 +394,7 @@ def test_three_racing_sweeps_never_hold_the_folder_lock_together(tmp_path):
     import time
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    start = str(time.time() + 1.0)
+    start = str(time.time() + 2.0)  # past the three interpreters' start-up, even on a loaded machine
     racers = [subprocess.Popen([sys.executable, "-c", _RACER, str(tmp_path), start], env=env,
                                stdout=subprocess.PIPE, text=True) for _ in range(3)]
     outputs = [p.communicate(timeout=30)[0] for p in racers]
