@@ -59,6 +59,8 @@ def test_the_next_save_removes_a_killed_runs_temp_files_but_not_a_live_ones(tmp_
 
     stale = tmp_path / ".trajectory.csv.k1ll3d_x.tmp"
     stale.write_bytes(b"0" * 100_000)  # a killed writer: nobody holds its lock
+    stale_gif = tmp_path / ".animation.gif.k1ll3d_y.tmp.gif"  # the GIF writer's temporary keeps .gif
+    stale_gif.write_bytes(b"GIF89a")
     live = tmp_path / ".summary.json.wr1t1ng_.tmp"
     live.write_text("{")
     mine = tmp_path / ".notes.txt"  # not one of our temporary names
@@ -66,7 +68,7 @@ def test_the_next_save_removes_a_killed_runs_temp_files_but_not_a_live_ones(tmp_
     with open(live, "rb") as holder:
         fcntl.flock(holder, fcntl.LOCK_EX)  # another run writing it right now
         save(_ball_run(0.1), tmp_path)
-    assert not stale.exists() and live.exists() and mine.exists()
+    assert not stale.exists() and not stale_gif.exists() and live.exists() and mine.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == [".notes.txt", ".summary.json.wr1t1ng_.tmp",
                                                           "summary.json", "trajectory.csv"]
 

@@ -45,18 +45,21 @@ def output_error(path, err: OSError) -> OutputError:
     return OutputError(f"cannot write {path}: {err.strerror or err}")
 
 
-# mkstemp's names: ".<file name>.<8 random characters>.tmp"
-_TEMP_NAME = re.compile(r"^\..+\.[a-z0-9_]{8}\.tmp$")
+# mkstemp's names: ".<file name>.<8 random characters>.tmp", or ".tmp.gif" (keep_extension)
+_TEMP_NAME = re.compile(r"^\..+\.[a-z0-9_]{8}\.tmp(\.[A-Za-z0-9]{1,5})?$")
 
 
 @contextlib.contextmanager
-def atomic_path(path: str | os.PathLike):
+def atomic_path(path: str | os.PathLike, keep_extension: bool = False):
     """Yield a temporary path next to `path`; rename it over `path` only on success.
-    An OSError while writing (ENOSPC, EROFS, ...) becomes an OutputError naming `path`."""
+    `keep_extension`: the temporary name ends with `path`'s extension too, for writers that
+    choose the format by it (Pillow's GIF, ffmpeg's MP4). An OSError while writing (ENOSPC,
+    EROFS, ...) becomes an OutputError naming `path`."""
     path = Path(path)
+    suffix = ".tmp" + (path.suffix if keep_extension else "")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     except OSError as err:
         raise output_error(path, err) from None
     try:

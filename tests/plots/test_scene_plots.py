@@ -91,6 +91,7 @@ def test_write_animation_gif_and_mp4_note(ladder_run, tmp_path):
 
     with Image.open(tmp_path / "animation.gif") as im:
         assert im.n_frames == 3
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left
     from nonsmooth_rod.plots.animation import ffmpeg_available
 
     assert (tmp_path / "animation.mp4").exists() == ffmpeg_available()

@@ -12,12 +12,11 @@ and the centre of mass as a cross. Contact forces are arrows N n + T t at the co
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..io import atomic_path
 from ..model.contacts import DiskOnDisk, DiskOnLine
 from ..validation import InputError
 
@@ -305,10 +304,8 @@ def write_animation(result, out_dir, frames: int = 120, fps: int = 25) -> list[s
     else:
         notes.append("ffmpeg not found: wrote animation.gif only (install ffmpeg for animation.mp4)")
     for name, writer in targets:
-        with tempfile.TemporaryDirectory(dir=out_dir, prefix=".anim.") as tmp:
-            path = Path(tmp) / name
-            anim.save(path, writer=writer)
-            os.replace(path, out_dir / name)
+        with atomic_path(out_dir / name, keep_extension=True) as tmp:
+            anim.save(tmp, writer=writer)
         notes.append(f"wrote {out_dir / name}")
     return notes
 
