@@ -46,12 +46,22 @@ ENABLED = HAVE_NUMBA and os.environ.get("NONSMOOTH_ROD_NO_JIT", "") in ("", "0")
 _warned = False
 
 
-def _warn_once() -> None:
+NO_NUMBA_MESSAGE = ("numba is not installed: Moreau–Jean runs interpreted, about 30x slower "
+                    "(pip install 'nonsmooth-rod[fast]')")
+
+
+def warn_once_without_numba() -> None:
+    """Said once per process, and only by a run that would have been compiled (the event-driven
+    and regularized methods never use numba): through the CLI's notifier (one line on stderr)
+    when one is set, else as a RuntimeWarning."""
     global _warned
-    if not HAVE_NUMBA and not _warned:
-        _warned = True
-        warnings.warn("numba is not installed: the compiled Moreau–Jean engine is off and runs are about "
-                      "30x slower (pip install 'nonsmooth-rod[fast]')", RuntimeWarning, stacklevel=3)
+    if HAVE_NUMBA or _warned:
+        return
+    _warned = True
+    if _notifier is not None:
+        _notifier(NO_NUMBA_MESSAGE)
+    else:
+        warnings.warn(NO_NUMBA_MESSAGE, RuntimeWarning, stacklevel=3)  # the driver's caller
 
 
 def jit(function):
@@ -60,7 +70,6 @@ def jit(function):
     Kernels take float64 arrays and int64 indices only, so each compiles to one signature.
     """
     if not ENABLED:
-        _warn_once()
         return function
     import numba
 

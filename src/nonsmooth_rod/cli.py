@@ -3,7 +3,8 @@
 The entry point only: each subcommand lives in `nonsmooth_rod.commands.<name>` with a
 `register(subparsers)` that sets its handler; shared option parsing is `commands.options`.
 Every mistake in the input ends with one line on stderr and exit status 2; a run that fails
-(solver failure, Painlevé stop) still writes its files and exits with status 1.
+(solver failure, Painlevé stop) still writes its files and exits with status 1, and so does one
+that cannot write them (a full disk) or loses a worker, with one line naming the cause.
 """
 from __future__ import annotations
 
@@ -11,7 +12,8 @@ import importlib
 import sys
 
 from . import __version__
-from .commands.options import EXIT_BAD_INPUT, Parser
+from .commands.options import EXIT_BAD_INPUT, EXIT_RUN_FAILED, Parser
+from .io import RunAborted
 from .validation import InputError
 
 # In the order `--help` lists them. A module that is missing (an optional part) is skipped.
@@ -33,11 +35,13 @@ def make_parser() -> Parser:
     return parser
 
 
-def _say_when_compiling() -> None:
-    """A first compiled run takes seconds: say so on stderr (stdout may carry JSON)."""
+def _say_when_compiling(quiet: bool = False) -> None:
+    """A first compiled run takes seconds, and one without numba is slow: say so in one line on
+    stderr (stdout may carry JSON), or nothing with --quiet."""
     from . import _jit
 
-    _jit.set_compile_notifier(lambda message: print(f"nonsmooth-rod: {message}", file=sys.stderr, flush=True))
+    _jit.set_compile_notifier((lambda message: None) if quiet else
+                              (lambda message: print(f"nonsmooth-rod: {message}", file=sys.stderr, flush=True)))
 
 
 def main(argv=None) -> int:
@@ -47,12 +51,14 @@ def main(argv=None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_BAD_INPUT
-        if not getattr(args, "quiet", False):
-            _say_when_compiling()
+        _say_when_compiling(quiet=getattr(args, "quiet", False))
         return args.handler(args)
     except InputError as err:
         print(f"nonsmooth-rod: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except RunAborted as err:  # a full disk, a lost worker: not the input's fault
+        print(f"nonsmooth-rod: {err}", file=sys.stderr)
+        return EXIT_RUN_FAILED
     except KeyboardInterrupt:
         print("nonsmooth-rod: interrupted", file=sys.stderr)
         return 130

@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
+from . import _jit
 from .integrators import METHODS, integrator_classes, supported_contacts
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
@@ -57,8 +59,13 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     opts = _options(options_cls, method, options, impact_stops)
     _check_output_size(method, opts, scene, t_end - t0, save_every)
     run_scene = _shifted(scene, t0)
+    if getattr(opts, "fast", False):  # a run that would be compiled: say once if numba is missing
+        _jit.warn_once_without_numba()
     result = integrator_cls(opts).run(run_scene, q0, v0, t_end - t0)
     result.method = method
+    # What the run was asked for, by the caller's names: saved results describe it (result_files).
+    result.run_inputs = {"scene": scene, "q0": q0, "v0": v0, "t0": t0, "t_end": t_end,
+                         "options": dict(options), "save_every": save_every, "stop": stop}
     if t0:
         _shift_times(result, t0)
     if callables:
@@ -149,8 +156,20 @@ def _force_shifted(force, t0: float):
     return force
 
 
+_TIME_IN_MESSAGE = re.compile(r"\b(t|t_end) = ([-+0-9.eE]+) s\b")
+
+
+def _shifted_time(match, t0: float) -> str:
+    try:
+        return f"{match[1]} = {float(match[2]) + t0:.12g} s"
+    except ValueError:
+        return match[0]
+
+
 def _shift_times(result: SimulationResult, t0: float) -> None:
     result.trajectory.t = result.trajectory.t + t0
+    # The integrators ran on a clock starting at 0: their messages' "t = … s" too.
+    result.message = _TIME_IN_MESSAGE.sub(lambda m: _shifted_time(m, t0), result.message)
     for event in result.events:
         event.t += t0
     for impact in result.impacts:

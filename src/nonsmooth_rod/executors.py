@@ -20,11 +20,17 @@ import os
 import signal
 import threading
 import time
+from concurrent.futures.process import BrokenProcessPool
 
+from .io import RunAborted
 from .validation import InputError
 
 EXECUTORS = ("local", "dask")
 PARENT_POLL_S = 0.25  # how often a local worker checks that its parent is alive
+
+
+class WorkerLost(RunAborted):
+    """A worker process of the local pool died (killed, out of memory): the pool is unusable."""
 
 
 def _watch_parent(parent_pid: int) -> None:
@@ -91,6 +97,9 @@ def open_executor(kind: str = "local", jobs: int = 2, scheduler: str | None = No
         pool.submit(os.getpid).result()
         try:
             yield pool, jobs
+        except BrokenProcessPool:
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise WorkerLost("a worker process died (killed, or out of memory)") from None
         except BaseException:
             pool.shutdown(wait=False, cancel_futures=True)
             raise

@@ -1,15 +1,27 @@
 """Writing results: every file is written to a temporary sibling and renamed into place, so an
-interrupted run never leaves a half-written file where a complete one is expected."""
+interrupted run never leaves a half-written file where a complete one is expected.
+
+A temporary file is locked (flock) by the process writing it, so the next run in the folder can
+tell the temporary files of a killed run (unlocked: removed by `remove_stale_temps`) from those
+of a run still writing. A write that fails (a full disk, a folder gone read-only) raises
+`OutputError` naming the file: the CLI says it in one line and exits 1."""
 from __future__ import annotations
 
 import contextlib
 import csv
+import hashlib
 import io
 import json
 import math
 import os
+import re
 import tempfile
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: temporary files are not locked, and never taken for stale
+    fcntl = None
 
 import numpy as np
 
@@ -20,21 +32,79 @@ _UMASK = os.umask(0)
 os.umask(_UMASK)
 
 
+class RunAborted(Exception):
+    """A run or a sweep stopped for a reason outside its input (a full disk, a worker process
+    killed): the CLI prints the message in one line and exits 1."""
+
+
+class OutputError(RunAborted):
+    """A results file could not be written; the message names it."""
+
+
+def output_error(path, err: OSError) -> OutputError:
+    return OutputError(f"cannot write {path}: {err.strerror or err}")
+
+
+# mkstemp's names: ".<file name>.<8 random characters>.tmp", or ".tmp.gif" (keep_extension)
+_TEMP_NAME = re.compile(r"^\..+\.[a-z0-9_]{8}\.tmp(\.[A-Za-z0-9]{1,5})?$")
+
+
 @contextlib.contextmanager
-def atomic_path(path: str | os.PathLike):
-    """Yield a temporary path next to `path`; rename it over `path` only on success."""
+def atomic_path(path: str | os.PathLike, keep_extension: bool = False):
+    """Yield a temporary path next to `path`; rename it over `path` only on success.
+    `keep_extension`: the temporary name ends with `path`'s extension too, for writers that
+    choose the format by it (Pillow's GIF, ffmpeg's MP4). An OSError while writing (ENOSPC,
+    EROFS, ...) becomes an OutputError naming `path`."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; give the file the usual permissions
+    suffix = ".tmp" + (path.suffix if keep_extension else "")
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    except OSError as err:
+        raise output_error(path, err) from None
+    try:
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX)  # ours while we write: not stale (remove_stale_temps)
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; give the file the usual permissions
         yield Path(tmp)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as err:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        if isinstance(err, OSError):
+            raise output_error(path, err) from None
         raise
+    finally:
+        os.close(fd)
+
+
+def remove_stale_temps(folder) -> list[Path]:
+    """Remove the temporary files a killed run left in `folder` (25 MB for a long trajectory):
+    those no live process holds locked. Returns what was removed."""
+    removed = []
+    if fcntl is None:
+        return removed
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(folder):
+            if not (_TEMP_NAME.match(entry.name) and entry.is_file(follow_symlinks=False)):
+                continue
+            try:
+                with open(entry.path, "rb") as fh:
+                    fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    os.unlink(entry.path)
+                removed.append(Path(entry.path))
+            except OSError:
+                continue  # locked: a run writing it now
+    return removed
+
+
+def file_digest(path) -> str:
+    """sha256 of a file's bytes (summary.json records those of the files it describes)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def write_text(path, text: str) -> None:

@@ -7,20 +7,27 @@
 
 Column names are `<body>.<quantity>` and `<contact>.<quantity>` (docs/output-format.md). A result
 made by `scenefile.simulate_scene` carries `result.scene_file`, which gives the names; otherwise
-bodies are body0, body1, ... and contacts keep the result's contact names.
+bodies keep their `RigidBody.name` (body0, body1, ... where names repeat) and contacts theirs.
+
+One run's files belong together: summary.json, written last, holds the run's id and the sha256
+of every file it describes, so `load` refuses a folder where a killed run replaced the
+trajectory but not the summary. Temporary files a killed run left are removed by the next save.
 """
 from __future__ import annotations
 
 import hashlib
+import math
+import uuid
 from pathlib import Path
 
 import numpy as np
 
-from .io import provenance, read_csv, write_csv, write_json, write_text
+from .io import file_digest, provenance, read_csv, remove_stale_temps, write_csv, write_json, write_text
 from .results import Event, Impact, Phase, SimulationResult, Trajectory
 from .validation import InputError
 
 SUMMARY_SCHEMA = "nonsmooth-rod/summary/2"
+ROD_SUMMARY_SCHEMA = "nonsmooth-rod/summary/1"  # `simulate`'s summary of the paper's rod (rod/simulation.py)
 BODY_QUANTITIES = ("x", "y", "theta", "vx", "vy", "omega")  # m, m, rad, m/s, m/s, rad/s
 CONTACT_QUANTITIES = ("N", "T", "mode")  # N, N, word
 
@@ -29,7 +36,13 @@ def body_names_of(result) -> list[str]:
     sf = getattr(result, "scene_file", None)
     if sf is not None:
         return list(sf.body_names)
-    return [f"body{i}" for i in range(result.trajectory.q.shape[1] // 3)]
+    n = result.trajectory.q.shape[1] // 3
+    scene = (getattr(result, "run_inputs", None) or {}).get("scene")
+    names = [str(b.name) for b in scene.bodies] if scene is not None and len(scene.bodies) == n else []
+    # Names become column prefixes: they must be distinct and not clash with the fallback ones.
+    if len(set(names)) == n and all(name and name.isprintable() and "." not in name for name in names):
+        return names
+    return [f"body{i}" for i in range(n)]
 
 
 def trajectory_columns(result) -> dict:
@@ -68,14 +81,89 @@ def _scene_block(result) -> dict:
     return block
 
 
+def _plain(value):
+    """A JSON-able copy of an option's value (a callable stop condition by its name)."""
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (bool, int, float, str)) or value is None:
+        return value
+    if isinstance(value, (np.floating, np.integer, np.ndarray)):
+        return value.tolist()
+    if hasattr(value, "contact"):  # StopAtImpact
+        return value.contact
+    return getattr(value, "__qualname__", None) or repr(value)
+
+
+def _law_data(law) -> dict:
+    return {"mu_s": law.friction.mu_s, "mu_d": law.friction.mu_d, "restitution": law.impact.restitution}
+
+
+def _contact_data(contact, bodies, lines) -> dict:
+    law = _law_data(contact.law)
+    if hasattr(contact, "body_a"):
+        return {"name": contact.name, "kind": "disk-on-disk", "body_a": bodies[contact.body_a],
+                "body_b": bodies[contact.body_b], "radius_a": contact.radius_a, "radius_b": contact.radius_b,
+                "offset_a": list(contact.offset_a), "offset_b": list(contact.offset_b), "law": law}
+    line = contact.line
+    name = next((n for n, known in lines.items() if known == line), f"line{len(lines)}")
+    lines[name] = line
+    kind = "disk-on-line" if contact.radius > 0 else "point-on-line"
+    data = {"name": contact.name, "kind": kind, "body": bodies[contact.body], "line": name,
+            "offset": list(contact.offset), "law": law}
+    return data | ({"radius": contact.radius} if contact.radius > 0 else {})
+
+
+def _force_data(force, bodies) -> dict:
+    import dataclasses
+
+    data = {k: _plain(v) for k, v in dataclasses.asdict(force).items()}
+    for key in ("body", "body_a", "body_b"):
+        if data.get(key) is not None:
+            data[key] = bodies[data[key]]
+    return {"kind": type(force).__name__, **data}
+
+
+def scene_description(result) -> dict | None:
+    """The scene and start of a run made through `nr.simulate` (no scene file), in the scene
+    file's layout (docs/scene-format.md): bodies, lines, contacts, forces, initial state."""
+    inputs = getattr(result, "run_inputs", None)
+    if not inputs:
+        return None
+    scene, bodies = inputs["scene"], body_names_of(result)
+    lines: dict = {}
+    contacts = [_contact_data(c, bodies, lines) for c in scene.contacts]
+    q0, v0 = np.asarray(inputs["q0"], float), np.asarray(inputs["v0"], float)
+    return {
+        "gravity": scene.gravity,
+        "bodies": [{"name": n, "mass": b.mass, "inertia": b.inertia} for n, b in zip(bodies, scene.bodies)],
+        "lines": [{"name": n, "point": list(line.point), "angle_deg": math.degrees(line.angle),
+                   "velocity": line.velocity} for n, line in lines.items()],
+        "contacts": contacts, "forces": [_force_data(f, bodies) for f in scene.forces],
+        "applied_force": _plain(scene.applied_force),
+        "initial": {n: {"q": q0[3 * i:3 * i + 3].tolist(), "v": v0[3 * i:3 * i + 3].tolist()}
+                    for i, n in enumerate(bodies)},
+    }
+
+
+def _run_options(result) -> dict:
+    sf = getattr(result, "scene_file", None)
+    if sf is not None:
+        return {**sf.options, "t_end": sf.t_end, "stop": sf.stop}
+    inputs = getattr(result, "run_inputs", None) or {}
+    keys = ("t0", "t_end", "save_every", "stop")
+    return {**_plain(inputs.get("options", {})), **{k: _plain(inputs[k]) for k in keys if k in inputs}}
+
+
 def summary_dict(result, command=None) -> dict:
     sf = getattr(result, "scene_file", None)
     bodies, contacts = body_names_of(result), list(result.contact_names)
     return {
-        "schema": SUMMARY_SCHEMA, "scene": _scene_block(result),
-        "params": sf.data if sf is not None else None,
+        "schema": SUMMARY_SCHEMA, "run_id": uuid.uuid4().hex, "scene": _scene_block(result),
+        "params": sf.data if sf is not None else scene_description(result),
         "method": result.method,
-        "options": ({**sf.options, "t_end": sf.t_end, "stop": sf.stop} if sf is not None else {}),
+        "options": _run_options(result),
         "status": str(getattr(result.status, "value", result.status)), "message": result.message,
         "success": bool(result.success),
         "phases": {c: [ph.as_dict() for ph in result.phases.get(c, [])] for c in contacts},
@@ -91,15 +179,82 @@ def scene_copy_name(sf) -> str:
 
 
 def save(result, out_dir, command=None) -> dict:
-    """Write trajectory.csv, summary.json and (for a scene-file run) the scene file's copy; returns the summary."""
+    """Write trajectory.csv, summary.json and (for a scene-file run) the scene file's copy; returns
+    the summary. summary.json comes last and records the others' sha256 (see the module doc)."""
     out_dir = Path(out_dir)
+    remove_stale_temps(out_dir)
     summary = summary_dict(result, command)
-    write_csv(out_dir / "trajectory.csv", trajectory_columns(result))
+    written = [out_dir / "trajectory.csv"]
+    write_csv(written[0], trajectory_columns(result))
     sf = getattr(result, "scene_file", None)
     if sf is not None and sf.text:
-        write_text(out_dir / scene_copy_name(sf), sf.text)
-    write_json(out_dir / "summary.json", summary)
+        written.append(out_dir / scene_copy_name(sf))
+        write_text(written[-1], sf.text)
+    write_summary(out_dir, summary, written)
     return summary
+
+
+def write_summary(out_dir, summary: dict, written) -> None:
+    """summary.json, last, with the sha256 of the files of the run it describes (`check_files`)."""
+    summary.setdefault("run_id", uuid.uuid4().hex)
+    summary["files"] = {Path(path).name: {"sha256": file_digest(path)} for path in written}
+    write_json(Path(out_dir) / "summary.json", summary)
+
+
+def check_files(folder: Path, summary: dict, run_kind: str = "run") -> None:
+    """Refuse a folder whose files are not the ones its summary.json describes (a run killed
+    between writing them, or a file replaced by hand), in one line."""
+    for name, record in (summary.get("files") or {}).items():
+        path = folder / name
+        try:
+            same = file_digest(path) == record.get("sha256")
+        except OSError as err:
+            raise InputError(f"{path}: cannot read ({err.strerror or err})") from None
+        if not same:
+            raise InputError(f"{folder}: mixed results: {name} is not the file summary.json describes "
+                             f"(run {summary.get('run_id', '?')}); a {run_kind} was interrupted or the file "
+                             "was changed: run it again into this folder")
+
+
+# ------------------------------------------------------------------ which command wrote a folder
+# `simulate` (the paper's rod) and `run` (any scene file) both write trajectory.csv and
+# summary.json, by default into ./results: the summary's schema tells them apart, so that each
+# reader says what it got, and no writer silently replaces the other's results.
+_KIND_OF_SCHEMA = {ROD_SUMMARY_SCHEMA: "simulate", SUMMARY_SCHEMA: "run"}
+_KIND_TEXT = {"simulate": "the results of `nonsmooth-rod simulate` (the paper's rod)",
+              "run": "the results of `nonsmooth-rod run` (a scene file)",
+              "sweep": "a sweep of `nonsmooth-rod sweep`",
+              "unknown": "a summary.json this program did not write"}
+
+
+def folder_kind(folder) -> str | None:
+    """"simulate", "run", "sweep", "unknown" (a summary.json of something else) or None (no results)."""
+    import json
+
+    folder = Path(folder)
+    if (folder / "sweep.json").is_file():
+        return "sweep"
+    try:
+        schema = json.loads((folder / "summary.json").read_text(encoding="utf-8")).get("schema")
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError, AttributeError):
+        return "unknown"
+    return _KIND_OF_SCHEMA.get(schema, "unknown")
+
+
+def describe_folder(folder) -> str:
+    return _KIND_TEXT.get(folder_kind(folder), "no results")
+
+
+def claim_folder(folder, kind: str, force: bool = False) -> None:
+    """Before `kind` ("simulate" or "run") writes into `folder`: refuse, in one line, to replace
+    the results of another command there unless `force`."""
+    found = folder_kind(folder)
+    if found is None or found == kind or force:
+        return
+    raise InputError(f"--out {folder} holds {_KIND_TEXT[found]}; `nonsmooth-rod {kind}` would overwrite "
+                     "them: choose another --out, or add --force to replace them")
 
 
 def _read_summary(folder: Path) -> dict:
@@ -112,8 +267,11 @@ def _read_summary(folder: Path) -> dict:
         raise InputError(f"{folder}: no summary.json here (not a results folder of `nonsmooth-rod run`)") from None
     except (OSError, ValueError) as err:
         raise InputError(f"{path}: cannot read: {err}") from None
-    if summary.get("schema") != SUMMARY_SCHEMA:
-        raise InputError(f"{path}: schema must be {SUMMARY_SCHEMA!r}, got {summary.get('schema')!r}")
+    if not isinstance(summary, dict) or summary.get("schema") != SUMMARY_SCHEMA:
+        kind = folder_kind(folder)
+        hint = (f"; draw it with `nonsmooth-rod plot {folder}`" if kind == "simulate" else "")
+        raise InputError(f"{folder} holds {_KIND_TEXT.get(kind, 'no results')}, not those of "
+                         f"`nonsmooth-rod run` (summary schema {SUMMARY_SCHEMA}){hint}")
     return summary
 
 
@@ -146,6 +304,7 @@ def load(folder):
 
     folder = Path(folder)
     summary = _read_summary(folder)
+    check_files(folder, summary)
     bodies, contacts = summary["scene"]["bodies"], summary["scene"]["contacts"]
     try:
         cols = read_csv(folder / "trajectory.csv")

@@ -195,3 +195,89 @@ def test_sweep_cli_on_a_dask_scheduler(tmp_path, capsys):
     assert "10 computed" in report and "scenario 2/2" in report
     table = read_csv(out / "regime_map.csv")
     assert table["theta0_deg"].tolist() == [50.0] * 5 + [60.0] * 5
+
+
+from nonsmooth_rod.rod.regime import _classify_chunk as _CLASSIFY_CHUNK  # noqa: E402
+
+SMALL_SWEEP = ["sweep", "--mu-s", "0.2:0.3:8", "--check", "0", "--no-plot", "--quiet"]
+
+
+def _sweep_table(out):
+    table = read_csv(out / "regime_map.csv")
+    return {k: v.tolist() for k, v in table.items()}
+
+
+def _one_line(capsys) -> str:
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err
+    return err
+
+
+def test_sweep_on_a_full_disk_ends_in_one_line_and_resumes(tmp_path, capsys, monkeypatch):
+    import builtins
+    import errno
+
+    from nonsmooth_rod.rod import regime
+
+    clean, out = tmp_path / "clean", tmp_path / "full"
+    assert main(SMALL_SWEEP + ["--jobs", "1", "--out", str(clean)]) == 0
+    real_open = builtins.open
+
+    class FillingDisk:  # the map's appends: three rows fit, then the disk is full
+        def __init__(self, fh):
+            self.fh, self.rows = fh, 0
+
+        def write(self, text):
+            self.rows += 1
+            if self.rows > 3:
+                raise OSError(errno.ENOSPC, "No space left on device")
+            return self.fh.write(text)
+
+        def __getattr__(self, name):
+            return getattr(self.fh, name)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.fh.close()
+
+    def open_on_a_full_disk(path, mode="r", *args, **kwargs):
+        fh = real_open(path, mode, *args, **kwargs)
+        return FillingDisk(fh) if str(path).endswith("regime_map.csv") and "a" in mode else fh
+
+    monkeypatch.setattr(regime, "open", open_on_a_full_disk, raising=False)
+    assert main(SMALL_SWEEP + ["--jobs", "1", "--out", str(out)]) == 1
+    assert _one_line(capsys) == f"nonsmooth-rod: cannot write {out / 'regime_map.csv'}: No space left on device"
+    assert len(read_csv(out / "regime_map.csv")["mu_s"]) == 3
+    monkeypatch.undo()
+    assert main(SMALL_SWEEP + ["--jobs", "1", "--out", str(out)]) == 0  # resumes: the other five points
+    assert _sweep_table(out) == _sweep_table(clean)
+
+
+def _killed_at_the_fourth_point(base, settings, columns, chunk):
+    import os
+    import signal
+
+    if any(abs(pt[0] - (0.2 + 3 * 0.1 / 7)) < 1e-12 for pt in chunk):
+        os.kill(os.getpid(), signal.SIGKILL)  # the worker dies as under the OOM killer
+    return _CLASSIFY_CHUNK(base, settings, columns, chunk)
+
+
+def test_a_killed_sweep_worker_ends_the_sweep_in_one_line_and_resume_finishes_it(tmp_path, capsys, monkeypatch):
+    import fcntl
+
+    from nonsmooth_rod.rod import regime
+
+    clean, out = tmp_path / "clean", tmp_path / "killed"
+    assert main(SMALL_SWEEP + ["--jobs", "1", "--out", str(clean)]) == 0
+    monkeypatch.setattr(regime, "_classify_chunk", _killed_at_the_fourth_point)  # the forked workers inherit it
+    assert main(SMALL_SWEEP + ["--jobs", "2", "--out", str(out)]) == 1
+    err = _one_line(capsys)
+    assert err.startswith("nonsmooth-rod: a worker process died") and "run the same sweep again to resume" in err
+    with open(out / ".sweep.lock", "a") as lock:  # free at once: no surviving worker holds it
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(lock, fcntl.LOCK_UN)
+    monkeypatch.undo()
+    assert main(SMALL_SWEEP + ["--jobs", "2", "--out", str(out)]) == 0
+    assert _sweep_table(out) == _sweep_table(clean)

@@ -168,6 +168,7 @@ def test_save_load_round_trip_and_restart(tmp_path):
     ball = toys.BouncingBall(restitution=0.8)
     later = restart(out, 0.6, t_end=1.5)
     assert later.t[0] == pytest.approx(0.6, abs=1e-12)
+    assert later.message == "reached t_end = 1.5 s"  # the integrator ran 0.9 s: its clock is shifted back
     assert later.impacts[0].t == pytest.approx(ball.impact_times(2)[1], abs=3 * H)
 
 
@@ -201,3 +202,47 @@ def test_restart_of_a_pushed_block_sees_the_push_at_absolute_time(tmp_path):
     assert later.t[0] == pytest.approx(0.6, abs=1e-12) and later.t[-1] == pytest.approx(1.0, abs=1e-12)
     # restarted from 0 the push would be 10 N/s · (t − 0.6) < μs m g: the block would stick again
     np.testing.assert_allclose(later.trajectory.q[:, 0], toy.position(later.t), atol=H * toy.velocity(1.0))
+
+
+def _one_error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err
+    return err
+
+
+def test_run_and_simulate_never_overwrite_each_others_folder(tmp_path, capsys):
+    """Both default to ./results: each refuses the other's folder in one line, --force replaces it."""
+    out = tmp_path / "results"
+    assert main(["simulate", "--t-end", "0.05", "--no-plot", "--quiet", "--out", str(out)]) == 0
+    rod_summary = (out / "summary.json").read_text()
+    assert main(["run", str(SCENES / "bouncing_ball.toml"), "--no-plot", "--quiet", "--out", str(out)]) == 2
+    assert "holds the results of `nonsmooth-rod simulate`" in _one_error_line(capsys)
+    assert (out / "summary.json").read_text() == rod_summary  # untouched
+    assert main(["animate", str(out)]) == 2
+    assert "`nonsmooth-rod plot " in _one_error_line(capsys)
+    assert main(["run", str(SCENES / "bouncing_ball.toml"), "--no-plot", "--quiet", "--out", str(out), "--force"]) == 0
+    assert json.loads((out / "summary.json").read_text())["schema"] == SUMMARY_SCHEMA
+    assert main(["simulate", "--t-end", "0.05", "--no-plot", "--quiet", "--out", str(out)]) == 2
+    assert "holds the results of `nonsmooth-rod run`" in _one_error_line(capsys)
+    assert main(["plot", str(out)]) == 2
+    assert f"`nonsmooth-rod animate {out}`" in _one_error_line(capsys)
+
+
+def test_a_full_disk_ends_in_one_line_naming_the_file_with_exit_1(tmp_path, capsys, monkeypatch):
+    import errno
+    import pathlib
+
+    real = pathlib.Path.write_text
+
+    def no_space(self, text, *args, **kwargs):
+        if self.name.startswith(".trajectory.csv."):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, text, *args, **kwargs)
+
+    monkeypatch.setattr(pathlib.Path, "write_text", no_space)
+    out = tmp_path / "full"
+    assert main(["run", str(SCENES / "bouncing_ball.toml"), "--no-plot", "--quiet", "--out", str(out)]) == 1
+    assert _one_error_line(capsys) == f"nonsmooth-rod: cannot write {out / 'trajectory.csv'}: No space left on device"
+    assert main(["simulate", "--t-end", "0.05", "--no-plot", "--quiet", "--out", str(out)]) == 1
+    assert _one_error_line(capsys).endswith("trajectory.csv: No space left on device")
+    assert list(out.iterdir()) == []  # no temp file left behind

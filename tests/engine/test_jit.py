@@ -100,3 +100,47 @@ def test_nested_blas_limits_restore_once_at_the_outermost_exit():
                 pass
             assert blas_threads() == {1}  # the inner exit does not lift the batch's limit
         assert blas_threads() == {2}
+
+
+# ------------------------------------------------------------ without numba
+def _without_numba(monkeypatch):
+    monkeypatch.setattr(_jit, "HAVE_NUMBA", False)
+    monkeypatch.setattr(_jit, "ENABLED", False)
+    monkeypatch.setattr(_jit, "_warned", False)
+
+
+def test_without_numba_the_cli_says_so_once_in_one_line_and_only_for_a_compiled_method(monkeypatch, tmp_path, capfd):
+    from nonsmooth_rod.cli import main
+
+    _without_numba(monkeypatch)
+    monkeypatch.setattr(_jit, "_notifier", None)
+    args = ["simulate", "--t-end", "0.02", "--no-plot", "--out", str(tmp_path)]
+    assert main(args + ["--force"]) == 0  # event-driven: numba plays no part
+    assert "numba" not in capfd.readouterr().err
+    assert main(args + ["--method", "moreau-jean", "--h", "1e-3", "--force"]) == 0
+    err = [line for line in capfd.readouterr().err.splitlines() if "numba" in line]
+    assert err == [f"nonsmooth-rod: {_jit.NO_NUMBA_MESSAGE}"]
+    assert main(args + ["--method", "moreau-jean", "--h", "1e-3", "--force"]) == 0
+    assert "numba" not in capfd.readouterr().err  # once per process
+    monkeypatch.setattr(_jit, "_warned", False)
+    assert main(args + ["--method", "moreau-jean", "--h", "1e-3", "--force", "--quiet"]) == 0
+    assert capfd.readouterr().err == ""
+
+
+def test_without_numba_the_library_warns_once_for_a_moreau_jean_run(monkeypatch):
+    import warnings
+
+    import nonsmooth_rod as nr
+    from nonsmooth_rod import toys
+
+    _without_numba(monkeypatch)
+    monkeypatch.setattr(_jit, "_notifier", None)
+    ball = toys.BouncingBall()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        nr.simulate(ball.scene(), *ball.initial_state(), 0.01, method="event-driven")
+        assert caught == []
+        nr.simulate(ball.scene(), *ball.initial_state(), 0.01, h=1e-3)
+        nr.simulate(ball.scene(), *ball.initial_state(), 0.01, h=1e-3)
+    assert [str(w.message) for w in caught] == [_jit.NO_NUMBA_MESSAGE]
+    assert caught[0].category is RuntimeWarning and caught[0].filename == __file__  # points at the caller

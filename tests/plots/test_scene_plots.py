@@ -91,6 +91,7 @@ def test_write_animation_gif_and_mp4_note(ladder_run, tmp_path):
 
     with Image.open(tmp_path / "animation.gif") as im:
         assert im.n_frames == 3
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left
     from nonsmooth_rod.plots.animation import ffmpeg_available
 
     assert (tmp_path / "animation.mp4").exists() == ffmpeg_available()
@@ -106,3 +107,77 @@ def test_animate_command_and_inline_html(tmp_path, ladder_run, capsys):
     html = animate(ladder_run, frames=2)
     text = html if isinstance(html, str) else html.data
     assert "<script" in text and "animation" in text.lower()
+
+
+def _ball_row(n: int, name_length: int = 12):
+    """n balls rolling on a floor, one contact each, with long contact names: a wide, flat scene."""
+    from nonsmooth_rod.scenefile import parse_scene
+
+    names = [f"ball{i}" for i in range(n)]
+    data = {"schema": "nonsmooth-rod/scene/1",
+            "bodies": [{"name": b, "shape": "disk", "radius": 0.05, "mass": 1.0} for b in names],
+            "lines": [{"name": "floor"}],
+            "contacts": [{"kind": "disk-on-line", "name": f"{b}-on-floor".ljust(name_length, "x"), "body": b,
+                          "line": "floor", "radius": 0.05, "law": {"mu_s": 0.3, "mu_d": 0.2}} for b in names],
+            "initial": {b: {"q": [0.3 * i, 0.05, 0.0], "v": [1.0 - 0.5 * (i % 3), 0.0, 0.0]}
+                        for i, b in enumerate(names)},
+            "simulation": {"t_end": 0.02, "h": 1e-3}}
+    return simulate_scene(parse_scene(data))
+
+
+@pytest.mark.parametrize("n_contacts", [1, 3, 7])
+def test_a_frame_shows_its_labels_and_status_whole(n_contacts, tmp_path):
+    """A flat scene made 480×192 frames that cut the x label off, and the status of three or more
+    contacts ran off the frame: every label and the whole status text now lie inside the frame."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    result = _ball_row(n_contacts)
+    anim = build_animation(result, frames=3)
+    fig = anim._fig
+    anim._func(2)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    ax = fig.axes[0]
+    frame = fig.bbox
+    status = fig.texts[0]
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    ticks = [t for t in ax.get_xticklabels() if x0 <= t.get_position()[0] <= x1] + \
+        [t for t in ax.get_yticklabels() if y0 <= t.get_position()[1] <= y1]  # the ones drawn
+    parts = [ax.xaxis.label, ax.yaxis.label, status, *ticks]
+    for artist in parts:
+        box = artist.get_window_extent(renderer)
+        assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1, artist
+    assert not status.get_window_extent(renderer).overlaps(ax.get_window_extent(renderer))
+    assert all(name in status.get_text() for name in result.contact_names)
+    width, height = (int(round(x)) for x in fig.get_size_inches() * fig.dpi)
+    assert width % 2 == 0 and height % 2 == 0  # video encoders want even sizes
+    canvas.print_png(tmp_path / "frame.png")
+    with Image.open(tmp_path / "frame.png") as im:
+        assert im.size == (width, height)
+    anim._draw_was_started = True
+
+
+def test_the_phase_bar_shares_no_colour_with_the_line_plots():
+    """Bodies and contacts are C0, C1, ... in the line plots; the phase bar's states are greys
+    and hatches (its own legend), so 'stick' cannot be read as 'the first body'."""
+    from matplotlib.colors import to_rgb
+
+    from nonsmooth_rod.plots.scene_figure import MODE_STYLES
+
+    result = _ball_row(3)
+    fig = result_figure(result)
+    phases = next(ax for ax in fig.axes if ax.get_label() == "phases")
+    line_colours = {to_rgb(line.get_color()) for ax in fig.axes for line in ax.lines
+                    if ax is not phases and line.get_linestyle() != "None"}
+    assert len(line_colours) >= 3
+    bars = [c for c in phases.collections if (c.get_gid() or "").startswith("phase:")]
+    assert {c.get_gid().rsplit(":", 1)[1] for c in bars} <= set(MODE_STYLES)
+    for bar in bars:
+        r, g, b = bar.get_facecolor()[0][:3]
+        assert r == g == b and (r, g, b) not in line_colours  # a grey, never a series' hue
+    looks = {(to_rgb(s["facecolor"]), s["hatch"]) for s in MODE_STYLES.values()}
+    assert len(looks) == len(MODE_STYLES)  # each state its own look
+    legend = [t.get_text() for t in phases.get_legend().get_texts()]
+    assert legend == ["open", "stick", "slip+", "slip−", "impact"]

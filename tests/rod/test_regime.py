@@ -206,7 +206,7 @@ def test_a_second_sweep_into_a_busy_folder_is_refused(tmp_path):
         with pytest.raises(InputError, match="another sweep is writing"):
             sweep(BASE, grid, tmp_path, jobs=1, plot=False)
     res = sweep(BASE, grid, tmp_path, jobs=1, plot=False)  # free again once the first is done
-    assert res.computed == 1 and not (tmp_path / regime.LOCK_NAME).exists()
+    assert res.computed == 1 and (tmp_path / regime.LOCK_NAME).exists()  # the lock stays; free again
 
 
 # --------------------------------------------------------------------------- the fast default path
@@ -357,3 +357,47 @@ def test_map_over_two_axes_shows_every_point_of_that_plane(tmp_path, y):
         assert list(start.get_xdata()) == pytest.approx([thresholds(BASE, t).T_over_N_initial for t in (45, 60)])
     with pytest.raises(InputError, match="cannot map axis"):
         axes_map_figure(res.grid_rows, grid, BASE, x="mu_s", y="mu_d")
+
+
+_RACER = """
+import os, sys, time
+from pathlib import Path
+from nonsmooth_rod.rod.regime import folder_lock
+from nonsmooth_rod.validation import InputError
+
+folder, held = Path(sys.argv[1]), 0
+start = float(sys.argv[2])
+while time.time() < start:  # all three start together
+    time.sleep(0.001)
+while time.time() < start + 1.5:
+    try:
+        with folder_lock(folder):
+            try:  # the one holder's mark: a second holder finds it there
+                os.close(os.open(folder / "holder", os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            except FileExistsError:
+                sys.exit(3)
+            held += 1
+            time.sleep(0.0005)
+            os.unlink(folder / "holder")
+    except InputError:
+        pass
+print(held)
+"""
+
+
+def test_three_racing_sweeps_never_hold_the_folder_lock_together(tmp_path):
+    """The lock file stays on disk: unlinked on release, a sweep that had opened the old file and
+    one creating a new file could both hold "the" lock (measured: within a second of racing)."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    start = str(time.time() + 2.0)  # past the three interpreters' start-up, even on a loaded machine
+    racers = [subprocess.Popen([sys.executable, "-c", _RACER, str(tmp_path), start], env=env,
+                               stdout=subprocess.PIPE, text=True) for _ in range(3)]
+    outputs = [p.communicate(timeout=30)[0] for p in racers]
+    assert [p.returncode for p in racers] == [0, 0, 0], "two sweeps held the lock at once"
+    assert sum(int(o) for o in outputs) > 100  # they really raced for it
+    assert (tmp_path / regime.LOCK_NAME).exists()

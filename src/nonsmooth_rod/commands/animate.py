@@ -22,12 +22,15 @@ def register(subparsers) -> None:
 
 def cmd_animate(args) -> int:
     from ..plots.animation import write_animation
-    from ..result_files import load
+    from ..result_files import describe_folder, folder_kind, load
 
     if not 2 <= args.frames <= 2000:
         raise InputError(f"--frames must lie in [2, 2000], got {args.frames}")
     if not 1 <= args.fps <= 120:
         raise InputError(f"--fps must lie in [1, 120], got {args.fps}")
+    if folder_kind(args.folder) == "simulate":
+        raise InputError(f"{args.folder} holds {describe_folder(args.folder)}; `animate` draws the results of "
+                         f"`nonsmooth-rod run`: draw the rod with `nonsmooth-rod plot {args.folder} --gif`")
     result = load(args.folder)
     if result.scene_file is None:
         raise InputError(f"{args.folder}: no scene copy (scene.toml/scene.json) to draw the bodies from")

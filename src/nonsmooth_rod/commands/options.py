@@ -114,6 +114,9 @@ def add_output_options(p: argparse.ArgumentParser, default_out: str = "results")
     out.add_argument("--json", action="store_true", help="print the summary JSON on stdout and nothing else there")
     out.add_argument("--no-plot", action="store_true", help="do not write figure.png")
     out.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    out.add_argument("--force", action="store_true",
+                     help="replace the results of another command in --out (`simulate` and `run` refuse to "
+                          "overwrite each other's folders without it)")
 
 
 def escape(text: str) -> str:

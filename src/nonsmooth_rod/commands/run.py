@@ -85,10 +85,11 @@ def cmd_run(args) -> int:
     from rich.console import Console
 
     from ..io import dumps_json
-    from ..result_files import save
+    from ..result_files import claim_folder, save
     from ..scenefile import load_scene, simulate_scene
 
     scene_file = load_scene(args.scene, args.set)
+    claim_folder(args.out, "run", args.force)
     out_dir = writable_folder(args.out)
     result = simulate_scene(scene_file)
     summary = save(result, out_dir)

@@ -94,20 +94,24 @@ def _print_report(run, out_dir: Path, console) -> None:
 
 
 def cmd_simulate(args) -> int:
-    from ..io import dumps_json, provenance, write_csv, write_json
+    from ..io import dumps_json, provenance, remove_stale_temps, write_csv
+    from ..result_files import claim_folder, write_summary
     from ..rod.simulation import TRAJECTORY_COLUMNS, simulate
+    from .run import writable_folder
 
     problem = build_problem(args)
     _check_numerics(args)
+    claim_folder(args.out, "simulate", args.force)
     extra = {} if args.max_step is None else {"max_step": args.max_step}
     run = simulate(problem, args.method, t_end=args.t_end, h=args.h, solver=args.solver, theta=args.theta,
                    min_phase=args.min_phase, rtol=args.rtol, atol=args.atol, epsilon=args.epsilon,
                    friction_curve=args.friction_curve, ode_method=args.ode_method, stiffness=args.stiffness,
                    damping=args.damping, time_limit=args.time_limit, **extra)
-    out_dir = Path(args.out)
+    out_dir = writable_folder(args.out)
+    remove_stale_temps(out_dir)
     summary = dict(run.summary(), provenance=provenance())
     write_csv(out_dir / "trajectory.csv", run.table, TRAJECTORY_COLUMNS)
-    write_json(out_dir / "summary.json", summary)
+    write_summary(out_dir, summary, [out_dir / "trajectory.csv"])
     if not args.no_plot:
         from ..rod.plotting import plot_run
         plot_run(run, out_dir / "figure.png")

@@ -12,12 +12,11 @@ and the centre of mass as a cross. Contact forces are arrows N n + T t at the co
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..io import atomic_path
 from ..model.contacts import DiskOnDisk, DiskOnLine
 from ..validation import InputError
 
@@ -192,10 +191,58 @@ def _force_scale(result, extent) -> float:
     return 0.2 * size / np.percentile(mags, 95) if mags.size else 0.0
 
 
+# A frame: the scene's box, 5.1 in wide, with fixed margins (inches) for the tick labels and the
+# axis labels, and a band above it for the status text. Nothing depends on the frame's content,
+# so nothing moves or is cut off from one frame to the next, whatever the scene's proportions.
+FRAME_WIDTH_IN = 6.0
+MARGINS_IN = {"left": 0.75, "right": 0.15, "bottom": 0.55, "top": 0.12}
+STATUS_FONT_PT = 8
+_CHAR_WIDTH_EM = 0.602  # DejaVu Sans Mono, matplotlib's monospace
+
+
+class StatusText:
+    """The time and every contact's state, in a fixed number of lines that fit the frame's width:
+    each entry padded to one width, so the text does not jump as states change."""
+
+    def __init__(self, contact_names):
+        self.names = list(contact_names)
+        self.width = max((len(n) for n in self.names), default=0) + len(":slip+")
+        chars = int((FRAME_WIDTH_IN - 0.2) * 72 / (_CHAR_WIDTH_EM * STATUS_FONT_PT))
+        self.per_line = max(1, (chars + 2) // (self.width + 2))
+        self.lines = 1 + math.ceil(len(self.names) / self.per_line)
+
+    def text(self, t: float, modes) -> str:
+        cells = [f"{n}:{m}".ljust(self.width) for n, m in zip(self.names, modes)]
+        rows = ["  ".join(cells[k:k + self.per_line]).rstrip() for k in range(0, len(cells), self.per_line)]
+        return "\n".join([f"t = {t:.4f} s", *rows])
+
+
+def _frame_figure(extent, status_lines: int, dpi: int):
+    """The Figure and the scene's axes, laid out in inches (see MARGINS_IN)."""
+    from matplotlib.figure import Figure
+
+    m = MARGINS_IN
+    box_w = FRAME_WIDTH_IN - m["left"] - m["right"]
+    box_h = box_w * min(max((extent[3] - extent[2]) / (extent[1] - extent[0]), 0.4), 1.6)
+    top = m["top"] + status_lines * STATUS_FONT_PT * 1.25 / 72
+    height = m["bottom"] + box_h + top
+    # Even pixel sizes: video encoders (H.264 in yuv420p) refuse odd ones.
+    width, height = (2 * math.ceil(x * dpi / 2) / dpi for x in (FRAME_WIDTH_IN, height))
+    fig = Figure(figsize=(width, height), dpi=dpi)
+    ax = fig.add_axes((m["left"] / width, m["bottom"] / height, box_w / width, box_h / height), label="scene")
+    # Equal scales by widening the view to the box's proportions, not by shrinking the box: it
+    # stays where the margins put it, filled.
+    x0, x1, y0, y1 = extent
+    grow_x = max(0.0, (y1 - y0) * box_w / box_h - (x1 - x0)) / 2
+    grow_y = max(0.0, (x1 - x0) * box_h / box_w - (y1 - y0)) / 2
+    ax.set(xlim=(x0 - grow_x, x1 + grow_x), ylim=(y0 - grow_y, y1 + grow_y), aspect="equal",
+           xlabel="x [m]", ylabel="y [m]")
+    return fig, ax
+
+
 def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int = 80):
     """A matplotlib FuncAnimation of the run (frames evenly spaced in time)."""
     from matplotlib import animation
-    from matplotlib.figure import Figure
     from matplotlib.transforms import Affine2D
 
     from .frames import frame_indices
@@ -205,16 +252,16 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
         raise InputError("animating a run needs its scene file (result.scene_file) to know the bodies' shapes")
     tr = result.trajectory
     extent = scene_extent(result, sf)
-    fig = Figure(figsize=(6, 6 * min(max((extent[3] - extent[2]) / (extent[1] - extent[0]), 0.4), 1.6)), dpi=dpi)
-    ax = fig.add_subplot(label="scene")
-    ax.set(xlim=extent[:2], ylim=extent[2:], aspect="equal", xlabel="x [m]", ylabel="y [m]")
+    status = StatusText(result.contact_names)
+    fig, ax = _frame_figure(extent, status.lines, dpi)
     draw_lines(ax, sf, extent)
     bodies = _make_artists(ax, sf)
     scale = _force_scale(result, extent)
     arrows = ax.quiver(np.zeros(len(sf.scene.contacts)), np.zeros(len(sf.scene.contacts)),
                        np.zeros(len(sf.scene.contacts)), np.zeros(len(sf.scene.contacts)),
                        angles="xy", scale_units="xy", scale=1.0, color="crimson", width=0.006, zorder=5)
-    label = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", family="monospace")
+    label = fig.text(0.1 / fig.get_figwidth(), 1 - 0.06 / fig.get_figheight(), "", va="top",
+                     family="monospace", fontsize=STATUS_FONT_PT)
     indices = frame_indices(tr.t, frames)
 
     def update(k):
@@ -231,8 +278,7 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
                             for c, g in enumerate(geo)]) * scale
             arrows.set_offsets(pts)
             arrows.set_UVC(vec[:, 0], vec[:, 1])
-        modes = " ".join(f"{n}:{tr.modes[i, c]}" for c, n in enumerate(result.contact_names))
-        label.set_text(f"t = {tr.t[i]:.4f} s  {modes}")
+        label.set_text(status.text(tr.t[i], tr.modes[i]))
         return []
 
     return animation.FuncAnimation(fig, update, frames=len(indices), interval=1000 / fps, blit=False)
@@ -258,10 +304,8 @@ def write_animation(result, out_dir, frames: int = 120, fps: int = 25) -> list[s
     else:
         notes.append("ffmpeg not found: wrote animation.gif only (install ffmpeg for animation.mp4)")
     for name, writer in targets:
-        with tempfile.TemporaryDirectory(dir=out_dir, prefix=".anim.") as tmp:
-            path = Path(tmp) / name
-            anim.save(path, writer=writer)
-            os.replace(path, out_dir / name)
+        with atomic_path(out_dir / name, keep_extension=True) as tmp:
+            anim.save(tmp, writer=writer)
         notes.append(f"wrote {out_dir / name}")
     return notes
 

@@ -8,8 +8,15 @@ import numpy as np
 
 from ..io import atomic_path
 
-MODE_COLOURS = {"open": "#d9d9d9", "stick": "#1f77b4", "slip+": "#d62728", "slip-": "#ff7f0e",
-                "flight": "#d9d9d9"}
+# The line plots colour bodies and contacts C0, C1, ... (blue, orange, green, red, ...): the phase
+# bar must not reuse a hue, or "stick" reads as "the first body". Its states are greys and
+# hatches instead — dark for stick, mirrored hatching for the two slip directions, pale for open.
+MODE_STYLES = {"open": {"facecolor": "#f2f2f2", "edgecolor": "#bdbdbd", "hatch": ""},
+               "stick": {"facecolor": "#404040", "edgecolor": "#404040", "hatch": ""},
+               "slip+": {"facecolor": "#ffffff", "edgecolor": "#404040", "hatch": "////"},
+               "slip-": {"facecolor": "#ffffff", "edgecolor": "#404040", "hatch": "\\\\"}}
+MODE_LABELS = {"open": "open", "stick": "stick", "slip+": "slip+", "slip-": "slip−"}
+OTHER_MODE = {"facecolor": "#969696", "edgecolor": "#969696", "hatch": "xx"}  # a word no law gives
 
 
 def body_names(result) -> list[str]:
@@ -95,21 +102,29 @@ def _ratios(ax, result) -> None:
         ax.legend(fontsize="x-small")
 
 
+def mode_style(mode) -> dict:
+    mode = str(mode)
+    return MODE_STYLES.get("open" if mode == "flight" else mode, OTHER_MODE)
+
+
 def _phases(ax, result) -> None:
+    from matplotlib.patches import Patch
+
     names = result.contact_names
     for k, name in enumerate(names):
         for ph in result.phases.get(name, []):
-            ax.broken_barh([(ph.t_start, ph.t_end - ph.t_start)], (k - 0.4, 0.8),
-                           color=MODE_COLOURS.get(str(ph.mode), "#9467bd"))
+            ax.broken_barh([(ph.t_start, ph.t_end - ph.t_start)], (k - 0.4, 0.8), linewidth=0.5,
+                           **mode_style(ph.mode), gid=f"phase:{name}:{ph.mode}")
     for imp in result.impacts:
         if imp.contact in names:
-            ax.plot(imp.t, names.index(imp.contact), "kv", ms=6)
-    from matplotlib.patches import Patch
-    ax.legend(handles=[Patch(color=c, label=m) for m, c in MODE_COLOURS.items() if m != "flight"]
-              + [ax.plot([], [], "kv")[0]], labels=["open", "stick", "slip+", "slip−", "impact"],
-              fontsize="x-small", ncol=5, loc="upper right")
+            ax.plot(imp.t, names.index(imp.contact), "v", color="white", mec="black", ms=7)
+    handles = [Patch(**style, linewidth=0.5, label=MODE_LABELS[m]) for m, style in MODE_STYLES.items()]
+    handles.append(ax.plot([], [], "v", color="white", mec="black", label="impact")[0])
+    ax.legend(handles=handles, fontsize="small", ncol=5, loc="lower left", bbox_to_anchor=(0.0, 1.0),
+              frameon=False, borderaxespad=0.2, handlelength=2.6, handleheight=1.3)
     ax.set_yticks(range(len(names)), names)
-    ax.set(xlabel="t [s]", title="phases per contact", ylim=(-0.6, max(len(names), 1) - 0.4 + 0.8))
+    ax.set(xlabel="t [s]", ylim=(-0.6, max(len(names), 1) - 0.4))
+    ax.set_title("phases per contact", loc="right")
     t = result.trajectory.t
     ax.set_xlim(t[0], t[-1] if t[-1] > t[0] else t[0] + 1)
 

@@ -19,6 +19,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..io import IMAGE_FORMATS, atomic_path, read_csv
+from ..result_files import check_files, describe_folder, folder_kind
 from ..plots.frames import frame_indices  # noqa: F401  (one frame picker for every animation)
 from .problem import RodProblem
 from ..results import Phase
@@ -94,6 +95,16 @@ def problem_from_params(params: dict, where: str = "summary.json") -> RodProblem
     return RodProblem(theta0=theta0, **values)
 
 
+def _refuse_other_results(folder: Path) -> None:
+    """A folder of `run` or `sweep` given to `plot`: say what it holds and what draws it."""
+    kind = folder_kind(folder)
+    hints = {"run": f"draw it with `nonsmooth-rod animate {folder}` (its figure is {folder / 'figure.png'})",
+             "sweep": f"its map is {folder / 'regime_map.png'}"}
+    if kind in hints:
+        raise InputError(f"{folder} holds {describe_folder(folder)}; `plot` draws the results of "
+                         f"`nonsmooth-rod simulate`: {hints[kind]}")
+
+
 def load_run_dir(folder, *, rolling: bool = True) -> RunData:
     """Read `folder/trajectory.csv` and `folder/summary.json` as written by `simulate`."""
     folder = Path(folder)
@@ -101,6 +112,7 @@ def load_run_dir(folder, *, rolling: bool = True) -> RunData:
         raise InputError(f"results folder '{folder}' does not exist")
     if not folder.is_dir():
         raise InputError(f"'{folder}' is not a folder (give the folder simulate wrote)")
+    _refuse_other_results(folder)
     traj_path, summary_path = folder / "trajectory.csv", folder / "summary.json"
     for path in (traj_path, summary_path):
         if not path.is_file():
@@ -111,6 +123,7 @@ def load_run_dir(folder, *, rolling: bool = True) -> RunData:
         raise InputError(f"{summary_path} is not valid JSON ({err.__class__.__name__}: {err})") from None
     if not isinstance(summary, dict) or not isinstance(summary.get("params"), dict):
         raise InputError(f"{summary_path} has no \"params\" object: not a summary written by simulate")
+    check_files(folder, summary, "simulate")
     problem = problem_from_params(summary["params"], str(summary_path))
     try:
         table = read_csv(traj_path)

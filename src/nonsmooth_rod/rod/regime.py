@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _jit
-from ..io import dumps_json, provenance, write_csv, write_json, write_text
+from ..io import dumps_json, output_error, provenance, remove_stale_temps, write_csv, write_json, write_text
 from ..validation import InputError
 from .problem import RodProblem
 from .regime_grid import (  # noqa: F401  (the grid's names, re-exported for the sweep's callers)
@@ -273,28 +273,54 @@ def _prepare_folder(out_dir: Path, record: dict, columns) -> list[dict]:
     return rows
 
 
+# flock belongs to the open file, which a fork shares: the local pool's workers, forked while the
+# sweep holds its folder's lock, would hold it too, and one still finishing its chunk after the
+# sweep stopped (a worker killed, Ctrl-C) would refuse the rerun. Each child drops it at once.
+_HELD_LOCKS: set[int] = set()
+
+
+def _drop_locks_in_child() -> None:
+    if not _HELD_LOCKS:
+        return
+    null = os.open(os.devnull, os.O_RDONLY)
+    for fd in _HELD_LOCKS:  # dup2, not close: the number stays valid for the file object that owns it
+        with contextlib.suppress(OSError):
+            os.dup2(null, fd)
+    os.close(null)
+    _HELD_LOCKS.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_drop_locks_in_child)
+
+
 @contextlib.contextmanager
 def folder_lock(out_dir: Path):
     """Refuse a second sweep writing into the same folder at the same time (their appends
-    would interleave). An advisory lock, released by the system if the process dies."""
+    would interleave). An advisory lock, released by the system if the process dies. The lock
+    file stays on disk: unlinking it on release would let a sweep that opened the old file and
+    one that creates a new one both hold "the" lock."""
     try:
         import fcntl
     except ImportError:  # not POSIX: no lock
         yield
         return
     path = out_dir / LOCK_NAME
-    fh = open(path, "w")
+    try:
+        fh = open(path, "a")  # never truncate: the file is the lock, not its content
+    except OSError as err:
+        raise output_error(path, err) from None
     try:
         fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         fh.close()
         raise InputError(f"another sweep is writing to {out_dir} (it holds {path}): wait for it or use "
                          "another --out") from None
+    _HELD_LOCKS.add(fh.fileno())
     try:
         yield
     finally:
-        with contextlib.suppress(OSError):
-            path.unlink()
+        _HELD_LOCKS.discard(fh.fileno())
         fh.close()
 
 
@@ -330,17 +356,22 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
         raise InputError(f"--out '{out_dir}' exists and is not a folder")
     _check_problems(base, grid)
     out_dir.mkdir(parents=True, exist_ok=True)
+    remove_stale_temps(out_dir)
     opts = dict(progress=progress, plot=plot, formats=formats, dpi=dpi, check_points=check_points,
                 map_axes=tuple(map_axes), command=command)
     with folder_lock(out_dir):
         if executor is not None and not isinstance(executor, str):
             return _sweep(base, grid, out_dir, settings, executor, jobs, **opts)
-        from ..executors import open_executor
+        from ..executors import WorkerLost, open_executor
 
         if executor in (None, "local"):
             warm_engine(settings)  # before forking: the workers inherit the loaded engine
-        with open_executor(executor or "local", jobs, scheduler) as (pool, workers):
-            return _sweep(base, grid, out_dir, settings, pool, workers, **opts)
+        try:
+            with open_executor(executor or "local", jobs, scheduler) as (pool, workers):
+                return _sweep(base, grid, out_dir, settings, pool, workers, **opts)
+        except WorkerLost as err:
+            raise WorkerLost(f"{err}: the sweep stopped; the points finished are kept in {out_dir / CSV_NAME}: "
+                             "run the same sweep again to resume") from None
 
 
 def _run_points(base, settings, columns, todo, pool, workers, on_rows, meanwhile=None) -> None:
@@ -413,9 +444,12 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
         bar.advance(len(points) - len(todo))
 
         def record_rows(rows):
-            sink.write(_row_lines(rows, columns))
+            try:
+                sink.write(_row_lines(rows, columns))
+                sink.flush()  # a row on disk is a row an interrupted sweep need not redo
+            except OSError as err:  # a full disk: the rows already written stay, resume redoes the rest
+                raise output_error(csv_path, err) from None
             new_rows.extend(rows)
-            sink.flush()  # a row on disk is a row an interrupted sweep need not redo
             bar.advance(len(rows))
 
         side: dict = {}

@@ -12,13 +12,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .problem import RodProblem
+from ..result_files import ROD_SUMMARY_SCHEMA
 from ..results import Phase, SimulationResult
 from .hypotheses import RollingHypothesis, rolling_hypothesis
 from ..validation import InputError, require_positive
 
 METHODS = ("event-driven", "moreau-jean", "regularized", "switched")
 TRAJECTORY_COLUMNS = ("t", "theta", "theta_dot", "theta_ddot", "x_O", "x_O_dot", "x_O_ddot", "N", "T", "mode")
-SUMMARY_SCHEMA = "nonsmooth-rod/summary/1"
+SUMMARY_SCHEMA = ROD_SUMMARY_SCHEMA
 MAX_DURATION = 10.0  # s; without --t-end the run stops at ball B's impact, well before this
 
 
