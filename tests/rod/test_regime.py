@@ -366,9 +366,11 @@ from nonsmooth_rod.rod.regime import folder_lock
 from nonsmooth_rod.validation import InputError
 
 folder, held = Path(sys.argv[1]), 0
-start = float(sys.argv[2])
-while time.time() < start:  # all three start together
-    time.sleep(0.001)
+(folder / f"ready.{os.getpid()}").touch()
+deadline = time.time() + 60.0
+while len(list(folder.glob("ready.*"))) < 3 and time.time() < deadline:  # all three start together,
+    time.sleep(0.001)                                                    # however slow their imports
+start = time.time()
 while time.time() < start + 1.5:
     try:
         with folder_lock(folder):
@@ -394,10 +396,9 @@ def test_three_racing_sweeps_never_hold_the_folder_lock_together(tmp_path):
     import time
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    start = str(time.time() + 2.0)  # past the three interpreters' start-up, even on a loaded machine
-    racers = [subprocess.Popen([sys.executable, "-c", _RACER, str(tmp_path), start], env=env,
+    racers = [subprocess.Popen([sys.executable, "-c", _RACER, str(tmp_path)], env=env,
                                stdout=subprocess.PIPE, text=True) for _ in range(3)]
-    outputs = [p.communicate(timeout=30)[0] for p in racers]
+    outputs = [p.communicate(timeout=120)[0] for p in racers]
     assert [p.returncode for p in racers] == [0, 0, 0], "two sweeps held the lock at once"
     assert sum(int(o) for o in outputs) > 100  # they really raced for it
     assert (tmp_path / regime.LOCK_NAME).exists()
