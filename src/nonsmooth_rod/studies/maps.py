@@ -1,7 +1,8 @@
 """Maps of any scene: the outcome of a scene file at every point of a grid of scene keys.
 
 An axis is a dotted path into the scene file (`contacts.foot.law.mu_s`, `lines.belt.velocity`,
-`contacts.*.law.mu_s` for every contact) with its values. Each point is the file with those
+`contacts.*.law.mu_s` for every contact, `initial.block.v.0` for a component; `a,b` for two keys
+moving together) with its values. Each point is the file with those
 values, run with the file's own method and options; its row holds the axes, then the outcome
 (outcome.py): the regime (every contact's phase sequence), status, whether the scene held, each
 contact's first slip / stick / lift-off / impact time, the final state. A point the scene
@@ -171,7 +172,8 @@ def _check_axes(data, source, axes) -> None:
     if n > MAX_POINTS:
         raise InputError(f"{n} grid points is too many (at most {MAX_POINTS})")
     for a in axes:
-        check_path(data, a.path, float(a.values[0]), "--axis")
+        for path in a.path.split(","):
+            check_path(data, path.strip(), float(a.values[0]), "--axis")
     parse_scene(data, source)  # the base scene itself must be valid
 
 

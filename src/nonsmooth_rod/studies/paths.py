@@ -81,10 +81,12 @@ def set_value(data: dict, path: str, value: float) -> None:
 
 
 def with_values(data: dict, values: dict) -> dict:
-    """A copy of `data` with every path of `values` set."""
+    """A copy of `data` with every path of `values` set; a key 'a,b' sets both paths (one axis
+    moving two keys together: a belt's speed and the block's initial velocity)."""
     out = copy.deepcopy(data)
-    for path, value in values.items():
-        set_value(out, path, value)
+    for paths, value in values.items():
+        for path in paths.split(","):
+            set_value(out, path.strip(), value)
     return out
 
 

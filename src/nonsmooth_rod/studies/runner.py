@@ -142,7 +142,8 @@ def sorted_unique(rows, key_columns) -> list[dict]:
 
 
 def write_table(path, rows, columns, key_columns) -> None:
-    write_text(path, ",".join(columns) + "\n" + row_lines(sorted_unique(rows, key_columns), columns))
+    header = row_lines([dict(zip(columns, columns))], columns)  # quoted where a name holds a comma
+    write_text(path, header + row_lines(sorted_unique(rows, key_columns), columns))
 
 
 def write_parquet(path: Path, csv_path: Path, columns, text_columns) -> Path:
