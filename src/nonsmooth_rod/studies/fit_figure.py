@@ -21,12 +21,14 @@ def _friction_pair(result) -> tuple[int, int] | None:
 
 
 def _events_panel(ax, result) -> None:
+    # Against the fitted time: the events lie far apart in t, their misfits within milliseconds.
     n = len(result.measurements.events)
     y = np.arange(n)
-    ax.errorbar(result.measured[:n], y, xerr=result.sigma[:n], fmt="o", color="k", label="measured ± σ")
-    ax.plot(result.fitted[:n], y, "x", color="#d62728", ms=9, label="fitted")
-    ax.set_yticks(y, result.labels[:n])
-    ax.set_xlabel("t [s]")
+    ms = 1e3 * (result.measured[:n] - result.fitted[:n])
+    ax.errorbar(ms, y, xerr=1e3 * result.sigma[:n], fmt="o", color="k", label="measured ± σ")
+    ax.plot(np.zeros(n), y, "x", color="#d62728", ms=9, label="fitted")
+    ax.set_yticks(y, [f"{lab}\n(fitted {t:.4f} s)" for lab, t in zip(result.labels[:n], result.fitted[:n])])
+    ax.set_xlabel("measured − fitted time [ms]")
     ax.set_title("events")
     ax.legend(fontsize=8)
 
@@ -55,9 +57,9 @@ def _region_panel(ax, result, i: int, j: int) -> None:
         pts = centre[:, None] + vecs @ (np.sqrt(np.clip(vals, 0, None) * dchi2)[:, None] * circle)
         ax.plot(pts[0], pts[1], label=f"{label} region")
     ax.plot(*centre, "k+", ms=10, label="estimate")
-    lo = min(pts[0].min(), pts[1].min())
-    hi = max(pts[0].max(), pts[1].max())
-    ax.plot([lo, hi], [lo, hi], ":", color="grey", label="μd = μs")
+    lo, hi = max(pts[0].min(), pts[1].min()), min(pts[0].max(), pts[1].max())
+    if lo < hi:  # the physical limit, where it crosses the region
+        ax.plot([lo, hi], [lo, hi], ":", color="grey", label="μd = μs")
     ax.set_xlabel(result.paths[i])
     ax.set_ylabel(result.paths[j])
     ax.set_title("confidence region (from the Jacobian)")
