@@ -53,8 +53,10 @@ def _slots(data: dict, path: str) -> list[tuple]:
             slots.append((n, int(last)))
         elif isinstance(n, dict):
             slots.append((n, last))
-        else:
+        elif isinstance(n, list):
             raise InputError(f"{path}: {'.'.join(walked)} has no entry {last!r}")
+        else:
+            raise InputError(f"{path}: {'.'.join(walked)} is a value, not a table")
     return slots
 
 
