@@ -22,6 +22,7 @@ from .solvers import ContactSolution, PlanarFrictionProblem, SolverError, solve
 from .validation import InputError
 from . import result_files as _result_files
 from .scenefile import load_scene, simulate_scene
+from .studies import fit, sweep
 
 load = _result_files.load
 
@@ -45,5 +46,5 @@ __all__ = [
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
     "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",
-    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce",
+    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "sweep", "fit",
 ]

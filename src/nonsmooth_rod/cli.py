@@ -1,4 +1,4 @@
-"""Nonsmooth contact dynamics of planar rigid bodies: simulate the paper's rod, run any scene, plot, sweep, benchmark.
+"""Nonsmooth contact dynamics of planar rigid bodies: simulate the paper's rod, run any scene, plot, sweep, fit, benchmark.
 
 The entry point only: each subcommand lives in `nonsmooth_rod.commands.<name>` with a
 `register(subparsers)` that sets its handler; shared option parsing is `commands.options`.
@@ -17,7 +17,7 @@ from .io import RunAborted
 from .validation import InputError
 
 # In the order `--help` lists them. A module that is missing (an optional part) is skipped.
-COMMANDS = ("simulate", "run", "animate", "plot", "sweep", "benchmark", "compile")
+COMMANDS = ("simulate", "run", "animate", "plot", "sweep", "fit", "benchmark", "compile")
 
 
 def make_parser() -> Parser:

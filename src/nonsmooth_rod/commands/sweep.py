@@ -1,4 +1,5 @@
-"""`nonsmooth-rod sweep`: the regime map over a grid of friction coefficients and tilts."""
+"""`nonsmooth-rod sweep`: the rod's regime map over a grid of friction coefficients and tilts,
+or, given a scene file, a map of that scene's outcomes over any of its keys (studies/maps.py)."""
 from __future__ import annotations
 
 import argparse
@@ -20,7 +21,17 @@ DIR/regime_map.png. Every axis takes START:STOP:N (N values, ends included), a,b
 number (then it is a fixed value, not an axis). Points run with Moreau–Jean (h = 2e-3, lemke)
 by default; a random sample is re-run with the event-driven reference and the agreement is
 reported. Rows are appended as they finish: rerunning an interrupted sweep with the same --out
-computes only the missing points."""
+computes only the missing points.
+
+Any scene: `sweep SCENE.toml --axis PATH=START:STOP:N --axis PATH=a,b,c [--set PATH=VALUE]`
+maps the outcome of the scene file over its keys (PATH as for `run --set`; `*` selects every
+entry: contacts.*.law.mu_s). Writes DIR/map.csv (the axes, then regime = every contact's phase
+sequence, status, held, each contact's first slip/stick/lift-off/impact time, the final state),
+map.parquet, sweep.json, map.png (regimes over --map-axes) and, with --refine K, boundaries.csv
+(each regime boundary bisected K times between neighbouring grid points). See docs/sweeps.md."""
+
+ROD_DEFAULTS = {"mu_s": "0.05:0.5:46", "theta0_deg": "60", "method": "moreau-jean", "h": 2e-3, "solver": "lemke",
+                "check": 8}
 
 RANGE_AXES = (("ball-radius", "ball radius r, m (default 0.020)"),
               ("rod-diameter", "rod diameter d, m (default 0.006)"),
@@ -38,20 +49,29 @@ def register(subparsers) -> None:
                               description=DESCRIPTION, conflict_handler="resolve",
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     add_physics_options(p)
+    scene = p.add_argument_group("a map of any scene")
+    scene.add_argument("scene", nargs="?", default=None, help="scene file (.toml/.json): map it over --axis keys")
+    scene.add_argument("--axis", action="append", default=[], metavar="PATH=START:STOP:N",
+                       help="an axis of the map: a scene key and its values (START:STOP:N or a,b,c); repeatable")
+    scene.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
+                       help="override a value of the scene file for every point (repeatable)")
+    scene.add_argument("--outcome", default=None,
+                       help="comma-separated outcome columns to keep (default all; regime and status always)")
+    scene.add_argument("--refine", type=_int, default=0, help="bisection steps per regime boundary (default 0)")
     g = p.add_argument_group("grid (each START:STOP:N, a,b,c or a number)")
-    g.add_argument("--mu-s", default="0.05:0.5:46", help="static friction μs (default 0.05:0.5:46)")
+    g.add_argument("--mu-s", default=None, help="static friction μs (default 0.05:0.5:46)")
     mu_d = g.add_mutually_exclusive_group()
     mu_d.add_argument("--mu-d-ratio", default=None, help="μd = R·μs, R in [0, 1] (default 0.75)")
     mu_d.add_argument("--mu-d", default=None, help="dynamic friction μd (points with μd > μs are skipped)")
-    g.add_argument("--theta0-deg", default="60", help="initial tilt θ0 in degrees (default 60)")
+    g.add_argument("--theta0-deg", default=None, help="initial tilt θ0 in degrees (default 60)")
     for name, text in RANGE_AXES:
         g.add_argument(f"--{name}", default=None, help=text)
     num = p.add_argument_group("numerics, execution and output")
-    num.add_argument("--method", default="moreau-jean", help="moreau-jean (default) or event-driven")
-    num.add_argument("--h", type=_float, default=2e-3,
+    num.add_argument("--method", default=None, help="moreau-jean (default) or event-driven")
+    num.add_argument("--h", type=_float, default=None,
                      help="Moreau-Jean step size, s (default 2e-3: times within 3h = 6 ms of the reference)")
-    num.add_argument("--solver", default="lemke", help="Moreau-Jean one-step solver (default lemke)")
-    num.add_argument("--check", type=_int, default=8,
+    num.add_argument("--solver", default=None, help="Moreau-Jean one-step solver (default lemke)")
+    num.add_argument("--check", type=_int, default=None,
                      help="points re-run with the event-driven reference to report the accuracy (default 8)")
     num.add_argument("--executor", default="local", help="local (a process pool, default) or dask")
     num.add_argument("--scheduler", default=None,
@@ -120,6 +140,17 @@ def _check_numerics(args) -> int:
 
 
 def cmd_sweep(args) -> int:
+    if args.scene is not None:
+        return cmd_scene_map(args)
+    if args.axis or args.set or args.outcome or args.refine:
+        raise InputError("--axis, --set, --outcome and --refine map a scene file: give SCENE.toml first")
+    for name, value in ROD_DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
+    return _rod_sweep(args)
+
+
+def _rod_sweep(args) -> int:
     from .options import build_problem, parse_image_formats
     from ..rod.regime import SweepSettings, sweep
 
@@ -177,4 +208,63 @@ def _report(result) -> None:
         extra = "".join(f", {k} = {v:g}" for k, v in th.params.items())
         console.print(f"θ0 = {th.theta0_deg:g}°{extra}: T/N(0) = {th.T_over_N_initial:.4f}, "
                       f"max T/N = {th.T_over_N_max:.4f} (t = {th.t_max:.4f} s), min T/N = {th.T_over_N_min:.4f}")
+    console.print("files: " + ", ".join(str(f) for f in result.files))
+
+
+def _refuse_rod_options(args) -> None:
+    rod = [n for n in ROD_DEFAULTS if getattr(args, n) is not None]
+    rod += [n for n in ("mu_d", "mu_d_ratio") if getattr(args, n) is not None]
+    rod += [n.replace("-", "_") for n, _ in RANGE_AXES if getattr(args, n.replace("-", "_")) is not None]
+    if rod:
+        raise InputError(f"--{rod[0].replace('_', '-')} is an option of the rod's sweep; a scene file is "
+                         "mapped over --axis PATH=... and run with its own simulation table (use --set)")
+
+
+def cmd_scene_map(args) -> int:
+    """`sweep SCENE.toml --axis ...`: the map of any scene (studies/maps.py)."""
+    from ..studies.maps import sweep as scene_sweep
+    from .options import parse_image_formats
+
+    _refuse_rod_options(args)
+    from ..rod.regime import default_jobs
+
+    jobs = default_jobs() if args.jobs is None else args.jobs
+    if not 1 <= jobs <= 64:
+        raise InputError(f"--jobs must lie in [1, 64], got {jobs}")
+    formats = () if args.no_plot else parse_image_formats(args.format)
+    if not 30 <= args.dpi <= 600:
+        raise InputError(f"--dpi must lie in [30, 600], got {args.dpi}")
+    outcomes = None if args.outcome is None else [o.strip() for o in args.outcome.split(",") if o.strip()]
+    map_axes = None if args.map_axes is None else [t.strip() for t in args.map_axes.split(",")]
+    result = scene_sweep(args.scene, args.axis, args.out, sets=args.set, outcomes=outcomes, refine=args.refine,
+                         jobs=jobs, executor=args.executor, scheduler=args.scheduler, plot=not args.no_plot,
+                         map_axes=map_axes, formats=formats, dpi=args.dpi,
+                         progress=not args.quiet and sys.stderr.isatty(), command=" ".join(sys.argv))
+    if not args.quiet:
+        _report_map(result)
+    return 1 if any(r["status"] == "failed" for r in result.rows) else 0
+
+
+def _report_map(result) -> None:
+    from collections import Counter
+
+    from rich.console import Console
+    from rich.table import Table
+
+    from .options import escape
+
+    console = Console()
+    counts = Counter(r["regime"] for r in result.rows)
+    table = Table(title=f"map of {len(result.rows)} points: regimes (each contact's phase sequence)")
+    table.add_column("regime")
+    table.add_column("points", justify="right")
+    for name, n in sorted(counts.items()):
+        table.add_row(escape(name), str(n))
+    console.print(table)
+    rate = result.computed / max(result.compute_s, 1e-9)
+    console.print(f"{result.computed} computed, {result.reused} from an earlier run; {rate:,.0f} points/s "
+                  f"({result.compute_s:.2f} s computing, {result.wall_s:.2f} s in all)")
+    for b in result.boundaries[:20]:
+        console.print(escape(f"boundary along {b['axis']} in [{b['lo']:.6g}, {b['hi']:.6g}]: "
+                             f"{b['regime_lo']} | {b['regime_hi']}"))
     console.print("files: " + ", ".join(str(f) for f in result.files))

@@ -27,23 +27,19 @@ and the accuracy check.
 """
 from __future__ import annotations
 
-import contextlib
-import csv
-import io
 import json
 import math
 import os
-import sys
 import time
 import zlib
-from concurrent.futures import FIRST_COMPLETED, wait
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .. import _jit
-from ..io import dumps_json, output_error, provenance, remove_stale_temps, write_csv, write_json, write_text
+from ..io import dumps_json, output_error, provenance, remove_stale_temps, write_csv, write_json
+from ..studies import runner
 from ..validation import InputError
 from .problem import RodProblem
 from .regime_grid import (  # noqa: F401  (the grid's names, re-exported for the sweep's callers)
@@ -143,56 +139,10 @@ def _classify_chunk(base: RodProblem, settings: SweepSettings, columns, points) 
         return [classify_point(base, dict(zip(columns, pt)), settings) for pt in points]
 
 
-# --------------------------------------------------------------------------- analytic thresholds
-def _cell(value) -> str:
-    if isinstance(value, float):
-        return "" if value != value else repr(float(value))  # shortest round-trip text; NaN empty
-    return str(value)
-
-
-def _row_lines(rows, columns) -> str:
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerows([[_cell(row[c]) for c in columns] for row in rows])
-    return buf.getvalue()
-
-
-def _parse_row(fields: list[str], columns) -> dict | None:
-    if len(fields) != len(columns):
-        return None
-    row = dict(zip(columns, fields))
-    try:
-        for c in columns:
-            if c not in TEXT_COLUMNS:
-                row[c] = float(row[c]) if row[c] != "" else math.nan
-    except ValueError:
-        return None
-    points = [row[c] for c in columns if c not in RESULT_COLUMNS]
-    if not row["scenario"] or not all(math.isfinite(v) for v in points):
-        return None
-    return row
-
-
+# --------------------------------------------------------------------------- CSV rows
 def read_rows(path, columns=CSV_COLUMNS) -> tuple[list[dict], int]:
     """Rows of a regime_map.csv and the number of unreadable lines (an interrupted write)."""
-    path = Path(path)
-    text = path.read_text(encoding="utf-8")
-    if text and not text.endswith("\n"):
-        # Every row is written with its newline: a last line without one was cut mid-write,
-        # even if its cells happen to parse (a truncated phases text would).
-        text = text[: text.rfind("\n") + 1]
-    lines = list(csv.reader(io.StringIO(text, newline="")))
-    if not lines:
-        return [], 0
-    if tuple(lines[0]) != tuple(columns):
-        raise InputError(f"{path} does not start with the header {','.join(columns)}: not this sweep's map")
-    rows, bad = [], 0
-    for fields in lines[1:]:
-        row = _parse_row(fields, columns)
-        if row is None:
-            bad += 1
-        else:
-            rows.append(row)
-    return rows, bad
+    return runner.read_table(path, columns, TEXT_COLUMNS, point_columns(columns), "scenario")
 
 
 def point_columns(columns) -> tuple:
@@ -201,13 +151,11 @@ def point_columns(columns) -> tuple:
 
 def sorted_rows(rows, columns=CSV_COLUMNS) -> list[dict]:
     """One row per point (the last one read wins), the first column varying fastest."""
-    pcols = point_columns(columns)
-    unique = {row_key(r, pcols): r for r in rows}
-    return [unique[k] for k in sorted(unique, key=lambda k: k[::-1])]
+    return runner.sorted_unique(rows, point_columns(columns))
 
 
 def write_rows(path, rows, columns=CSV_COLUMNS) -> None:
-    write_text(path, ",".join(columns) + "\n" + _row_lines(sorted_rows(rows, columns), columns))
+    runner.write_table(path, rows, columns, point_columns(columns))
 
 
 def rows_as_columns(rows, columns=CSV_COLUMNS) -> dict:
@@ -273,59 +221,7 @@ def _prepare_folder(out_dir: Path, record: dict, columns) -> list[dict]:
     return rows
 
 
-# flock belongs to the open file, which a fork shares: the local pool's workers, forked while the
-# sweep holds its folder's lock, would hold it too, and one still finishing its chunk after the
-# sweep stopped (a worker killed, Ctrl-C) would refuse the rerun. Each child drops it at once.
-_HELD_LOCKS: set[int] = set()
-
-
-def _drop_locks_in_child() -> None:
-    if not _HELD_LOCKS:
-        return
-    null = os.open(os.devnull, os.O_RDONLY)
-    for fd in _HELD_LOCKS:  # dup2, not close: the number stays valid for the file object that owns it
-        with contextlib.suppress(OSError):
-            os.dup2(null, fd)
-    os.close(null)
-    _HELD_LOCKS.clear()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_drop_locks_in_child)
-
-
-@contextlib.contextmanager
-def folder_lock(out_dir: Path):
-    """Refuse a second sweep writing into the same folder at the same time (their appends
-    would interleave). An advisory lock, released by the system if the process dies. The lock
-    file stays on disk: unlinking it on release would let a sweep that opened the old file and
-    one that creates a new one both hold "the" lock."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX: no lock
-        yield
-        return
-    path = out_dir / LOCK_NAME
-    try:
-        fh = open(path, "a")  # never truncate: the file is the lock, not its content
-    except OSError as err:
-        raise output_error(path, err) from None
-    try:
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        fh.close()
-        raise InputError(f"another sweep is writing to {out_dir} (it holds {path}): wait for it or use "
-                         "another --out") from None
-    _HELD_LOCKS.add(fh.fileno())
-    try:
-        yield
-    finally:
-        _HELD_LOCKS.discard(fh.fileno())
-        fh.close()
-
-
-def _chunks(points, size):
-    return [points[i:i + size] for i in range(0, len(points), size)]
+folder_lock = runner.folder_lock
 
 
 def _check_problems(base: RodProblem, grid: Grid) -> None:
@@ -375,57 +271,13 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
 
 
 def _run_points(base, settings, columns, todo, pool, workers, on_rows, meanwhile=None) -> None:
-    """Classify `todo`, in this process (pool None) or in chunks on `pool`; `on_rows` gets each
-    finished chunk's rows as they arrive. `meanwhile()` runs in this process, in a thread
-    while the workers compute (after them without a pool)."""
+    """Classify `todo`, in this process (pool None) or in chunks on `pool` (runner.run_chunked)."""
     if pool is None:
         warm_engine(settings)
         with _jit.one_blas_thread():  # once for the batch, not once per short run
-            for pt in todo:
-                on_rows([classify_point(base, dict(zip(columns, pt)), settings)])
-        if meanwhile is not None:
-            meanwhile()
+            runner.run_chunked(_classify_chunk, (base, settings, columns), todo, None, 1, on_rows, meanwhile)
         return
-    # Chunks: little pickling overhead per point, yet a progress bar that moves and enough
-    # tasks to balance the workers.
-    size = max(1, min(250, len(todo) // (8 * workers)))
-    pending = {pool.submit(_classify_chunk, base, settings, columns, chunk) for chunk in _chunks(todo, size)}
-    side = _Background(meanwhile)
-    try:
-        while pending:
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in finished:
-                on_rows(fut.result())
-    except BaseException:
-        for fut in pending:
-            fut.cancel()
-        raise
-    side.join()
-
-
-class _Background:
-    """A function run in a thread; join() re-raises what it raised."""
-
-    def __init__(self, fn):
-        import threading
-
-        self.error = None
-        self.thread = None
-        if fn is not None:
-            self.thread = threading.Thread(target=self._run, args=(fn,), daemon=True, name="sweep-side")
-            self.thread.start()
-
-    def _run(self, fn):
-        try:
-            fn()
-        except BaseException as err:  # handed to the main thread
-            self.error = err
-
-    def join(self):
-        if self.thread is not None:
-            self.thread.join()
-        if self.error is not None:
-            raise self.error
+    runner.run_chunked(_classify_chunk, (base, settings, columns), todo, pool, workers, on_rows, meanwhile)
 
 
 def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, formats, dpi, check_points,
@@ -440,12 +292,12 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
     todo = [pt for pt in points if point_key(pt) not in done]
     new_rows: list[dict] = []
     csv_path = out_dir / CSV_NAME
-    with open(csv_path, "a", newline="", encoding="utf-8") as sink, _progress(progress, len(points)) as bar:
+    with open(csv_path, "a", newline="", encoding="utf-8") as sink, runner.progress(progress, len(points)) as bar:
         bar.advance(len(points) - len(todo))
 
         def record_rows(rows):
             try:
-                sink.write(_row_lines(rows, columns))
+                sink.write(runner.row_lines(rows, columns))
                 sink.flush()  # a row on disk is a row an interrupted sweep need not redo
             except OSError as err:  # a full disk: the rows already written stay, resume redoes the rest
                 raise output_error(csv_path, err) from None
@@ -492,32 +344,9 @@ def _write_outputs(out_dir, columns, rows, ths, record, grid, accuracy, command,
     grid_record = {name: values.tolist() for name, values in grid.axes.items()}
     write_json(out_dir / SETTINGS_NAME, record | {"grid": grid_record, "counts": counts, "accuracy": accuracy,
                                                   "provenance": provenance(command)})
-    if _has_pyarrow():
-        files.append(write_parquet(out_dir / PARQUET_NAME, out_dir / CSV_NAME, columns))
+    if runner.has_pyarrow():
+        files.append(runner.write_parquet(out_dir / PARQUET_NAME, out_dir / CSV_NAME, columns, TEXT_COLUMNS))
     return files
-
-
-def write_parquet(path: Path, csv_path: Path, columns) -> Path:
-    """The table as Parquet, atomically, converted from the final CSV by Arrow's own reader:
-    building it from Python values would import pandas (a second) through pyarrow."""
-    import pyarrow as pa
-    import pyarrow.csv as pa_csv
-    import pyarrow.parquet as pq
-
-    from ..io import atomic_path
-
-    types = {c: pa.string() if c in TEXT_COLUMNS else pa.float64() for c in columns}
-    table = pa_csv.read_csv(csv_path, convert_options=pa_csv.ConvertOptions(
-        column_types=types, strings_can_be_null=False, include_columns=list(columns)))
-    with atomic_path(path) as tmp:
-        pq.write_table(table, tmp)
-    return path
-
-
-def _has_pyarrow() -> bool:
-    import importlib.util
-
-    return importlib.util.find_spec("pyarrow") is not None
 
 
 # --------------------------------------------------------------------------- accuracy
@@ -571,48 +400,6 @@ def accuracy_text(acc: dict) -> str:
             f"{acc['max_abs_error_t_transition_s']:.2g} s, impact ≤ {acc['max_abs_error_t_impact_s']:.2g} s "
             f"({verdict} the stated {acc['time_tolerance_s']:.2g} s)")
 
-
-# --------------------------------------------------------------------------- progress
-class _NoProgress:
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
-    def advance(self, n):
-        pass
-
-
-class _RichProgress:
-    def __init__(self, total):
-        from rich.console import Console
-        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TextColumn,
-                                   TimeRemainingColumn)
-        from rich.text import Text
-
-        class Rate(ProgressColumn):
-            def render(self, task):
-                return Text(f"{task.speed or 0:,.0f} points/s", style="progress.data.speed")
-
-        self.progress = Progress(TextColumn("sweep"), BarColumn(), MofNCompleteColumn(), Rate(),
-                                 TimeRemainingColumn(), console=Console(file=sys.stderr), transient=False)
-        self.total = total
-
-    def __enter__(self):
-        self.progress.__enter__()
-        self.task = self.progress.add_task("sweep", total=self.total)
-        return self
-
-    def __exit__(self, *exc):
-        return self.progress.__exit__(*exc)
-
-    def advance(self, n):
-        self.progress.advance(self.task, n)
-
-
-def _progress(enabled: bool, total: int):
-    return _RichProgress(total) if enabled else _NoProgress()
 
 # --------------------------------------------------------------------------- the map
 

@@ -9,6 +9,8 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from ..studies.runner import (  # noqa: F401  (re-exported)
+    KEY_DIGITS, LOCK_NAME, has_repeats, parse_range, point_key, row_key)
 from ..validation import InputError
 from .hypotheses import RollingHypothesis, rolling_hypothesis
 from .problem import RodProblem
@@ -24,12 +26,10 @@ CSV_COLUMNS = ("mu_s", "mu_d", "theta0_deg") + RESULT_COLUMNS  # a μs × μd(or
 CSV_NAME, SETTINGS_NAME, THRESHOLDS_NAME, MAP_NAME = ("regime_map.csv", "sweep.json", "thresholds.csv",
                                                       "regime_map")
 PARQUET_NAME = "regime_map.parquet"
-LOCK_NAME = ".sweep.lock"
 SWEEP_SCHEMA = "nonsmooth-rod/sweep/2"
 SCENARIO_COLOURS = {"slide-at-start": "#d62728", "roll-until-r1": "#ff9f4a", "roll-until-r2": "#8fbbe0",
                     "roll-to-impact": "#1f5fa8"}
 OTHER_COLOUR = "#444444"  # runs that ended with another status (painleve, failed, ...)
-KEY_DIGITS = 12  # grid values are matched to this many decimals when resuming
 
 # --------------------------------------------------------------------------- one point
 @dataclass(frozen=True)
@@ -122,50 +122,6 @@ def predicted_scenario(rh: RollingHypothesis, mu_s: float) -> tuple[str, float]:
 
 
 # --------------------------------------------------------------------------- grids
-def _range_values(text: str, name: str, max_count: int) -> np.ndarray:
-    parts = text.split(":")
-    usage = f"{name}: expected START:STOP:N, a,b,c or a number, got {text!r}"
-    if len(parts) != 3:
-        raise InputError(usage)
-    try:
-        start, stop = float(parts[0]), float(parts[1])
-    except ValueError:
-        raise InputError(usage) from None
-    if not (math.isfinite(start) and math.isfinite(stop)):
-        raise InputError(f"{name}: values must be finite, got {text!r}")
-    if not parts[2].strip().isdigit():
-        raise InputError(f"{name}: the count N in START:STOP:N must be a positive integer, got {parts[2]!r}")
-    count = int(parts[2])
-    if not 1 <= count <= max_count:
-        raise InputError(f"{name}: the count N must lie in [1, {max_count}], got {count}")
-    if count == 1 and start != stop:
-        raise InputError(f"{name}: one value between {start:g} and {stop:g}? give N ≥ 2 or a single number")
-    if stop < start:
-        raise InputError(f"{name}: the range {text!r} runs backwards: give START ≤ STOP")
-    if count > 1 and start == stop:
-        raise InputError(f"{name}: {count} values from {start:g} to {stop:g} are all the same: give N = 1")
-    return np.linspace(start, stop, count)
-
-
-def parse_range(text: str, name: str, *, max_count: int = 2000) -> np.ndarray:
-    """'START:STOP:N' (N values, ends included, START ≤ STOP), 'a,b,c' (no repeats) or a number."""
-    text = str(text).strip()
-    if ":" in text:
-        values = _range_values(text, name, max_count)
-    else:
-        try:
-            values = np.array([float(x) for x in text.split(",")])
-        except ValueError:
-            raise InputError(f"{name}: expected START:STOP:N, a,b,c or a number, got {text!r}") from None
-    if not np.all(np.isfinite(values)):
-        raise InputError(f"{name}: values must be finite, got {text!r}")
-    if values.size > max_count:
-        raise InputError(f"{name}: at most {max_count} values, got {values.size}")
-    if _has_repeats(values):
-        raise InputError(f"{name}: a value is given twice in {text!r}")
-    return values
-
-
 # What a sweep accepts per axis (lo, hi, lo open, hi open): beyond these the physics overflows
 # or stops being the paper's (a rod of 100 m, a density above osmium's ×5, μ above 100).
 AXIS_LIMITS = {"mu_s": (0.0, 100.0, False, False), "mu_d": (0.0, 100.0, False, False),
@@ -185,22 +141,13 @@ def check_axis_values(name: str, values) -> None:
         raise InputError(f"--{name.replace('_', '-')}: values must lie in {interval}, got {bad[0]:g}")
 
 
-def _has_repeats(values: np.ndarray) -> bool:
-    """Two values equal to KEY_DIGITS decimals (the resume key). Huge values are refused by
-    the axis limits later; rounding them must not warn of an overflow first."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        rounded = np.round(values, KEY_DIGITS)
-    rounded = np.where(np.isfinite(rounded), rounded, values)
-    return np.unique(rounded).size != rounded.size
-
-
 def _axis_array(name: str, values) -> np.ndarray:
     arr = np.atleast_1d(np.asarray(values, dtype=float)).ravel()
     if arr.size == 0:
         raise InputError(f"--{name.replace('_', '-')}: no values")
     if not np.all(np.isfinite(arr)):
         raise InputError(f"--{name.replace('_', '-')}: values must be finite, got {arr.tolist()}")
-    if _has_repeats(arr):
+    if has_repeats(arr):
         raise InputError(f"--{name.replace('_', '-')}: a value is given twice: {arr.tolist()}")
     return arr
 
@@ -284,14 +231,6 @@ class Grid:
                 else:
                     pts.extend((ms, float(md), th) + rest for md in self.mu_d if md <= ms)
         return pts
-
-
-def point_key(values) -> tuple:
-    return tuple([round(float(v), KEY_DIGITS) for v in values])
-
-
-def row_key(row: dict, columns) -> tuple:
-    return tuple([round(float(row[c]), KEY_DIGITS) for c in columns])
 
 
 # --------------------------------------------------------------------------- CSV rows
