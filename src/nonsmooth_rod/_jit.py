@@ -135,7 +135,7 @@ def purge_stale_kernels() -> bool:
     return True
 
 
-__all__ = ["jit", "ENABLED", "one_blas_thread", "compiling", "compile_in_background", "compile_policy"]
+__all__ = ["jit", "ENABLED", "one_blas_thread", "compiling", "compile_in_background", "start_compile_job", "compile_policy"]
 
 
 # ---------------------------------------------------------------- BLAS threads
@@ -332,9 +332,9 @@ class compiling:
         return False
 
 
-def compile_in_background(part: str, args: list[str], what: str, seconds: float) -> bool:
+def start_compile_job(part: str, args: list[str]) -> bool:
     """Start a detached process that compiles `part` (python -m nonsmooth_rod._compile_job ARGS)
-    unless one is already at it; says once that the run goes on interpreted. True if started."""
+    unless some process is compiling it now; its pid is written beside the marker. True if started."""
     import subprocess
     import sys
 
@@ -350,6 +350,13 @@ def compile_in_background(part: str, args: list[str], what: str, seconds: float)
                                    start_new_session=True, close_fds=True)
         _marker(part).with_suffix(".pid").write_text(f"{job.pid}\n")
     except OSError:
+        return False
+    return True
+
+
+def compile_in_background(part: str, args: list[str], what: str, seconds: float) -> bool:
+    """start_compile_job, and say once that the run goes on interpreted meanwhile."""
+    if not start_compile_job(part, args):
         return False
     _say(part + ":background", f"running interpreted: this run is shorter than compiling {what} "
                                f"(~{seconds:.0f} s), which goes on in the background for later runs")

@@ -46,6 +46,9 @@ def test_without_qpsolvers_the_exact_solvers_remain(monkeypatch):
         return real_import(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", no_qpsolvers)
+    from nonsmooth_rod.solvers import qp
+
+    monkeypatch.setattr(qp, "_BACKENDS", None)  # probed once per process: probe again without qpsolvers
     assert available_solvers() == ["lemke", "pgs", "enum"]
     with pytest.raises(ValueError, match="choose from: lemke, pgs, enum$"):
         solve(block_on_incline(0.3, 0.5), "osqp")
@@ -111,3 +114,26 @@ print("ok", solutions[0].info["states"])
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "ok ['slip+']"
+
+
+def test_the_qp_backends_are_probed_once_per_process(monkeypatch):
+    """A missing qpsolvers is not imported again on every call (Python does not cache a failed
+    import: ~60 µs a call, issue 25)."""
+    import builtins
+
+    from nonsmooth_rod.solvers import qp
+
+    monkeypatch.setattr(qp, "_BACKENDS", None)
+    tries = []
+    real_import = builtins.__import__
+
+    def counting(name, *args, **kwargs):
+        if name == "qpsolvers":
+            tries.append(name)
+            raise ImportError("qpsolvers hidden for this test")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", counting)
+    for _ in range(3):
+        assert available_solvers() == ["lemke", "pgs", "enum"]
+    assert tries == ["qpsolvers"]
