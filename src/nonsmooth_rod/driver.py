@@ -18,7 +18,7 @@ from ._jit import compiling_notice
 from .integrators import METHODS, integrator_classes, supported_contacts
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
-from .validation import InputError, require_finite, require_positive, require_state
+from .validation import InputError, quoted, require_finite, require_positive, require_state
 
 # Refuse a run whose saved output would exceed this (bytes), before allocating anything.
 MAX_OUTPUT_BYTES = 4 * 2**30
@@ -36,7 +36,7 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     """Simulate `scene` from (q0, v0) at time t0 to t_end with the named method.
 
     method: "moreau-jean" (options h, theta, solver, solver_options, activation_gamma,
-    min_phase, fast), "event-driven" (rtol, atol, max_step, output_dt, ...) or "regularized"
+    min_phase, fast), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...) or "regularized"
     (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping, time_limit, ...).
     save_every: keep one sample per this many seconds (default: every step / output_dt).
     stop: a contact name or `StopAtImpact(name)` (the run ends at that contact's first
@@ -72,8 +72,8 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
 
 
 def _method(method, scene: Scene):
-    if method not in METHODS:
-        raise InputError(f"unknown method {method!r}; choose from: {', '.join(METHODS)}")
+    if not isinstance(method, str) or method not in METHODS:
+        raise InputError(f"unknown method {quoted(method)}; choose from: {', '.join(METHODS)}")
     handled = supported_contacts(method)
     for contact in scene.contacts:
         if type(contact).__name__ not in handled:
@@ -106,7 +106,7 @@ def _options(options_cls, method: str, options: dict, impact_stops: list):
     valid = [f.name for f in dataclasses.fields(options_cls) if f.name != "stop_at_impact"]
     for key in options:
         if key not in valid:
-            raise InputError(f"unknown option {key!r} for method {method!r}; options: {', '.join(valid)}")
+            raise InputError(f"unknown option {quoted(key)} for method {method!r}; options: {', '.join(valid)}")
     if impact_stops:
         options = dict(options, stop_at_impact=impact_stops[0])
     try:

@@ -47,9 +47,25 @@ from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
-from ..validation import InputError, require_positive, require_state
+from ..solvers import available_solvers
+from ..validation import (
+    Choice,
+    InputError,
+    Integer,
+    Number,
+    Text,
+    check_options,
+    option,
+    require_positive,
+    require_state,
+)
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+# scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
+RTOL_FLOOR = 100 * float(np.finfo(float).eps)
+# An absolute tolerance on positions (m) and velocities (m/s) beyond this is no tolerance: the
+# solver's steps then skip over the events (atol = 1e20 wrote −inf into the trajectory).
+ATOL_CEILING = 1e-2
 MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 
 
@@ -57,28 +73,24 @@ MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 class EventDrivenOptions:
     """Accuracy and stopping controls of the event-driven integrator."""
 
-    rtol: float = 1e-12
-    atol: float = 1e-12
-    method: str = "DOP853"
-    output_dt: float = 1e-3  # spacing of the saved samples (events are always saved)
+    rtol: float = option(1e-12, Number(RTOL_FLOOR, 0.1))
+    atol: float = option(1e-12, Number(0.0, ATOL_CEILING, open_lo=True))
+    ode_method: str = option("DOP853", Choice(ODE_METHODS))
+    # spacing of the saved samples (events are always saved)
+    output_dt: float = option(1e-3, Number(0.0, open_lo=True))
     # Events are found within each step, whatever its length (see `_Watch`): the cap only
     # bounds the step for whoever wants it; infinity (the default) leaves it to the tolerance.
-    max_step: float = math.inf
-    stop_at_impact: str | None = None  # name of a contact whose first impact ends the run
-    max_events: int = 10_000
-    zeno_interval: float = 1e-9  # impacts closer than this in time: an accumulation point
-    impact_solver: str = "enum"
-    gap_tol: float = 1e-9
-    velocity_tol: float = 1e-9
+    max_step: float = option(math.inf, Number(0.0, open_lo=True, infinite=True))
+    stop_at_impact: str | None = option(None, Text())  # name of a contact whose first impact ends the run
+    max_events: int = option(10_000, Integer(1, 10**9))
+    # impacts closer than this in time: an accumulation point (s)
+    zeno_interval: float = option(1e-9, Number(0.0, 1e-3))
+    impact_solver: str = option("enum", Choice(available_solvers))
+    gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
+    velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
 
     def __post_init__(self):
-        require_positive("rtol", self.rtol)
-        require_positive("atol", self.atol)
-        require_positive("output_dt", self.output_dt)
-        if self.method not in ODE_METHODS:
-            raise InputError(f"method must be one of {', '.join(ODE_METHODS)}, got {self.method!r}")
-        if not (isinstance(self.max_step, (int, float)) and self.max_step > 0):  # inf: no cap
-            raise InputError(f"max_step must be positive (inf: no cap), got {self.max_step!r}")
+        check_options(self)
 
 
 class _Stop(Exception):
@@ -473,7 +485,7 @@ class EventDriven:
         def rhs(t, y):
             return np.concatenate([y[n:], mode_dynamics(scene, t, y[:n], y[n:], frozen).a])
         o = self.options
-        return getattr(scipy.integrate, o.method)(rhs, t0, y0, t_end, rtol=o.rtol, atol=o.atol,
+        return getattr(scipy.integrate, o.ode_method)(rhs, t0, y0, t_end, rtol=o.rtol, atol=o.atol,
                                                   max_step=o.max_step)
 
     def _segment(self, scene, run, modes, t_end):
