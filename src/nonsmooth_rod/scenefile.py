@@ -25,7 +25,7 @@ from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, Line
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
-from .validation import InputError, quoted, require_finite
+from .validation import MAX_INTEGER, InputError, quoted, require_finite
 
 try:
     import tomllib
@@ -39,7 +39,6 @@ NAME_PATTERN = re.compile(r"[A-Za-z0-9_+\-]{1,200}")  # fullmatch: no trailing n
 OVERLAP_TOLERANCE = 1e-9  # m per metre of the scene's size: penetration allowed in the initial state
 _REQUIRED = object()
 MAX_DEPTH = 16  # tables and lists nest at most this deep (a scene needs 4)
-MAX_INTEGER = 2**63 - 1  # integers beyond int64 are refused (no number of the engine needs them)
 
 TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "contacts", "forces",
             "initial", "simulation")

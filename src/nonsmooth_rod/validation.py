@@ -14,11 +14,15 @@ import numbers
 import reprlib
 from dataclasses import dataclass
 
+import numpy as np
+
 
 class InputError(ValueError):
     """Invalid user input. The message is one line, meant to be shown as is."""
 
 
+_BOOLS = (bool, np.bool_)  # not numbers, whatever int(True) says
+MAX_INTEGER = 2**63 - 1  # integers the engine holds (int64); a float holds larger numbers
 # An error message quotes at most this much of a bad value (a 20 MB string is not repeated).
 QUOTE_LIMIT = 80
 _QUOTER = reprlib.Repr()
@@ -40,12 +44,15 @@ def quoted(value) -> str:
 
 def _real(name: str, value) -> float:
     """value as a float if it is a real number (not a bool, not a string), else InputError."""
-    if isinstance(value, bool) or type(value).__name__ == "bool_" or not isinstance(value, numbers.Real):
+    if isinstance(value, _BOOLS) or not isinstance(value, numbers.Real):
         raise InputError(f"{name} must be a number, got {quoted(value)}")
+    if isinstance(value, numbers.Integral) and abs(int(value)) > MAX_INTEGER:
+        raise InputError(f"{name} is an integer beyond ±2^63, more than the engine holds: {quoted(value)} "
+                         "(write a float, e.g. 1e30)")
     try:
         return float(value)
-    except OverflowError:
-        raise InputError(f"{name} must be finite, got an integer beyond the float range: {quoted(value)}") from None
+    except OverflowError:  # a huge Fraction, say
+        raise InputError(f"{name} must be finite, got {quoted(value)}") from None
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a number, got {quoted(value)}") from None
 
@@ -84,7 +91,7 @@ def require_in_range(name: str, value, lo: float, hi: float, *, open_lo=False, o
 
 def require_integer(name: str, value, lo: int, hi: int) -> int:
     """A whole number in [lo, hi]: an int (not a bool), or a float with no fractional part."""
-    if isinstance(value, bool) or type(value).__name__ == "bool_":
+    if isinstance(value, _BOOLS):
         raise InputError(f"{name} must be a whole number in [{lo}, {hi}], got {quoted(value)}")
     if isinstance(value, numbers.Integral):
         number = int(value)
@@ -99,7 +106,7 @@ def require_integer(name: str, value, lo: int, hi: int) -> int:
 
 def require_flag(name: str, value) -> bool:
     """A bool option takes a bool: not the string "false" (which Python counts as true), not 0/1."""
-    if isinstance(value, bool) or type(value).__name__ == "bool_":
+    if isinstance(value, _BOOLS):
         return bool(value)
     raise InputError(f"{name} must be true or false, got {quoted(value)}")
 
@@ -158,8 +165,6 @@ def require_point(name: str, value) -> tuple[float, float]:
 
 def require_state(name: str, value, n_dof: int):
     """An initial state q0 or v0: exactly n_dof finite numbers (x, y, θ per body), as float64."""
-    import numpy as np
-
     if value is None:
         raise InputError(f"{name} must be a sequence of {n_dof} numbers (x, y, θ per body), got None")
     try:
