@@ -243,6 +243,8 @@ def _plausible(out_dir: Path, code: int) -> str:
 
     summary = json.loads((out_dir / "summary.json").read_text())
     table = pd.read_csv(out_dir / "trajectory.csv")
+    if table.empty:
+        return f"empty trajectory.csv (status {summary.get('status')})"
     numbers = table[[c for c in table.columns if not c.endswith(".mode")]].to_numpy(dtype=float)
     status = summary.get("status")
     if not np.all(np.isfinite(numbers)):
@@ -281,7 +283,10 @@ def battery(seed: int, count: int, subprocesses: int = 0, verbose: bool = False)
             runs = [run_in_process] + ([run_subprocess] if k < subprocesses else [])
             for runner in runs:
                 code, stderr, problem = runner(path, out_dir)
-                verdict = judge(code, stderr, problem, out_dir)
+                try:
+                    verdict = judge(code, stderr, problem, out_dir)
+                except Exception as err:  # noqa: BLE001 - unreadable output is a finding too
+                    verdict = f"output not readable: {type(err).__name__}: {str(err)[:200]}"
                 if verdict:
                     results["failures"].append(f"{name}: {description}: {verdict}")
                 elif runner is run_in_process:

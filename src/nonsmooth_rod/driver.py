@@ -22,6 +22,8 @@ from .validation import InputError, quoted, require_finite, require_positive, re
 
 # Refuse a run whose saved output would exceed this (bytes), before allocating anything.
 MAX_OUTPUT_BYTES = 4 * 2**30
+# A max_step asking scipy for more steps than this is refused (about a minute of stepping).
+MAX_CAPPED_STEPS = 10**6
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,7 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     integrator_cls, options_cls = _method(method, scene)
     impact_stops, callables = _stop_conditions(stop, scene)
     opts = _options(options_cls, method, options, impact_stops)
+    _check_step_cap(opts, t_end - t0)
     _check_output_size(method, opts, scene, t_end - t0, save_every)
     run_scene = _shifted(scene, t0)
     compiled = method == "moreau-jean" and opts.fast and opts.solver in ("lemke", "pgs", "enum")
@@ -115,6 +118,15 @@ def _options(options_cls, method: str, options: dict, impact_stops: list):
         raise
     except (TypeError, ValueError) as err:
         raise InputError(f"invalid option for method {method!r}: {err}") from None
+
+
+def _check_step_cap(opts, duration: float) -> None:
+    """Refuse a step cap (`max_step` of the ODE methods) that makes the run a hang: more than
+    MAX_CAPPED_STEPS steps of scipy's integrators (each tens of microseconds)."""
+    cap = getattr(opts, "max_step", math.inf)
+    if duration / cap > MAX_CAPPED_STEPS:
+        raise InputError(f"max_step = {cap:g} s over a run of {duration:g} s asks for more than "
+                         f"{MAX_CAPPED_STEPS:.0e} ODE steps: use max_step ≥ {duration / MAX_CAPPED_STEPS:.3g} s")
 
 
 def _check_output_size(method: str, opts, scene: Scene, duration: float, save_every) -> None:

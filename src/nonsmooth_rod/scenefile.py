@@ -25,7 +25,7 @@ from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, Line
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
-from .validation import MAX_INTEGER, InputError, quoted, require_finite
+from .validation import MAX_INTEGER, MAX_STATE, InputError, quoted, require_finite
 
 try:
     import tomllib
@@ -412,6 +412,9 @@ def _initial(w, data, body_names) -> tuple[np.ndarray, np.ndarray]:
         _check_keys(w, init[name], ("q", "v"), key)
         q0[3 * i:3 * i + 3] = _vector(w, init[name], "q", key, 3)
         v0[3 * i:3 * i + 3] = _vector(w, init[name], "v", key, 3, [0.0, 0.0, 0.0])
+        for part, values in (("q", q0[3 * i:3 * i + 3]), ("v", v0[3 * i:3 * i + 3])):
+            if np.max(np.abs(values)) > MAX_STATE:
+                raise w.error(f"{key}.{part}", f"must lie within ±{MAX_STATE:g}, got {quoted(values.tolist())}")
     return q0, v0
 
 

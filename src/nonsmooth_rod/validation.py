@@ -23,6 +23,7 @@ class InputError(ValueError):
 
 _BOOLS = (bool, np.bool_)  # not numbers, whatever int(True) says
 MAX_INTEGER = 2**63 - 1  # integers the engine holds (int64); a float holds larger numbers
+MAX_STATE = 1e100  # |q|, |v| of an initial state: v² and k·q stay far from float64's 1.8e308
 # An error message quotes at most this much of a bad value (a 20 MB string is not repeated).
 QUOTE_LIMIT = 80
 _QUOTER = reprlib.Repr()
@@ -178,6 +179,9 @@ def require_state(name: str, value, n_dof: int):
         raise InputError(f"{name} must hold {n_dof} numbers (x, y, θ per body), got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         raise InputError(f"{name} must be finite, got {quoted(array.tolist())}")
+    if np.max(np.abs(array), initial=0.0) > MAX_STATE:
+        raise InputError(f"{name} must lie within ±{MAX_STATE:g} (its squares, energies and forces must not "
+                         f"overflow), got {quoted(array.tolist())}")
     return array
 
 

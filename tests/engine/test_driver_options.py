@@ -96,3 +96,14 @@ def test_checked_values_are_what_the_run_uses():
 @pytest.mark.parametrize("method", [["moreau-jean"], 7, None])
 def test_a_method_that_is_not_a_name(method):
     assert "unknown method" in refusal(method)
+
+
+@pytest.mark.parametrize("method", ["event-driven", "regularized"])
+def test_a_step_cap_that_would_hang_is_refused(method):
+    assert "max_step = 1e-12 s over a run of 0.05 s asks for more than" in refusal(method, max_step=1e-12)
+
+
+def test_an_initial_state_whose_squares_overflow_is_refused():
+    scene, q0, _ = dropped_ball()
+    with pytest.raises(nr.InputError, match=r"v0 must lie within ±1e\+100"):
+        nr.simulate(scene, q0, [1e300, 0.0, 0.0], 0.05, "event-driven")

@@ -341,6 +341,32 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
 
 
 @jit
+def _contact_scales(W, n_c):
+    """Per contact the power of two nearest 1/√max(W_NN, W_TT) (1 for a zero block)."""
+    d = np.ones(n_c)
+    for c in range(n_c):
+        diagonal = max(abs(W[2 * c][2 * c]), abs(W[2 * c + 1][2 * c + 1]))
+        if diagonal > 0.0:
+            d[c] = 2.0 ** (-np.round(0.5 * np.log2(diagonal)))
+    return d
+
+
+@jit
+def _scaled_step(W, q, d, Ws, qs):
+    """Ws = D W D, qs = D q; returns (max|W|, max|q|, max|Ws| or 1, max|qs| or 1)."""
+    W_norm, q_norm, ws_norm, qs_norm = 0.0, 0.0, 0.0, 0.0
+    for i in range(q.shape[0]):
+        q_norm = max(q_norm, abs(q[i]))
+        qs[i] = q[i] * d[i // 2]
+        qs_norm = max(qs_norm, abs(qs[i]))
+        for j in range(q.shape[0]):
+            W_norm = max(W_norm, abs(W[i][j]))
+            Ws[i][j] = W[i][j] * d[i // 2] * d[j // 2]
+            ws_norm = max(ws_norm, abs(Ws[i][j]))
+    return W_norm, q_norm, (ws_norm if ws_norm > 0.0 else 1.0), (qs_norm if qs_norm > 0.0 else 1.0)
+
+
+@jit
 def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms).
 
@@ -348,34 +374,32 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     states (computed here, they cost nothing; in Python after the call, microseconds).
 
     ``formulation``: INTERVAL (3 unknowns per contact) or CONE (4 per contact). The LCP is
-    built from W / max|W| and q / max|q| so that the pivoting tolerances act on O(1)
-    numbers; p = p̃ · max|q| / max|W| undoes it exactly (u scales with max|q|).
+    built from D W D and D q, D = diag(d_c) per contact (both rows of a contact alike, which
+    leaves its friction interval as it is; d_c a power of two near 1/√W_cc: exact), then
+    divided by max|D W D| and max|D q|, so that the pivoting tolerances act on O(1) numbers
+    even when the contacts' W blocks differ by 1e12 (a heavy and a light body); p = D p̃ ·
+    max|D q| / max|D W D| undoes it exactly.
     """
     n_c = len(lo)
-    W_norm = 0.0
-    q_norm = 0.0
-    for i in range(2 * n_c):
-        q_norm = max(q_norm, abs(q[i]))
-        for j in range(2 * n_c):
-            W_norm = max(W_norm, abs(W[i][j]))
-    w_scale = W_norm if W_norm > 0.0 else 1.0
-    q_scale = q_norm if q_norm > 0.0 else 1.0
+    d = _contact_scales(W, n_c)
+    Ws, qs = np.empty((2 * n_c, 2 * n_c)), np.empty(2 * n_c)
+    W_norm, q_norm, w_scale, q_scale = _scaled_step(W, q, d, Ws, qs)
     per_contact = 3 if formulation == INTERVAL else 4
     n = per_contact * n_c
     M = np.zeros((n, n))
     qq = np.zeros(n)
     if formulation == INTERVAL:
-        _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
+        _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
-        _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
+        _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     z, status, pivots, entering = _lemke_kernel(M, qq, max_pivots)
 
     p = np.zeros(2 * n_c)
     u = np.zeros(2 * n_c)
     residual = 0.0
     if status == SOLVED or status == RAY:
-        to_impulse = q_scale / w_scale
         for j in range(n_c):
+            to_impulse = d[j] * q_scale / w_scale
             k = per_contact * j
             p[2 * j] = z[k] * to_impulse
             if formulation == INTERVAL:
