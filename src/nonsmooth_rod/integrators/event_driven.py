@@ -36,6 +36,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,6 +92,21 @@ class EventDrivenOptions:
 
     def __post_init__(self):
         check_options(self)
+
+
+def _finite_part(result: SimulationResult) -> SimulationResult:
+    """The result up to its first non-finite sample (q, v, N or T), then status "failed"."""
+    tr = result.trajectory
+    bad = ~(np.all(np.isfinite(tr.q), axis=1) & np.all(np.isfinite(tr.v), axis=1)
+            & np.all(np.isfinite(tr.normal_force), axis=1) & np.all(np.isfinite(tr.tangential_force), axis=1))
+    if not bad.any():
+        return result
+    k = int(np.argmax(bad))
+    t_bad = float(tr.t[k])
+    result.trajectory = Trajectory(tr.t[:k], tr.q[:k], tr.v[:k], tr.a[:k], tr.normal_force[:k],
+                                   tr.tangential_force[:k], tr.modes[:k])
+    result.set_status("failed", f"non-finite state at t = {t_bad:.9g} s (the integration diverged)")
+    return result
 
 
 class _Stop(Exception):
@@ -435,14 +451,19 @@ class EventDriven:
         wall = time.process_time()
         names = [c.name for c in scene.contacts]
         run = _Run(0.0, q, v)
-        try:
-            modes = self._decide(scene, 0.0, q, v)
-            run.events.append(Event(0.0, "start", "", {"modes": list(modes)}))
-            status, message = self._loop(scene, run, modes, t_end, names)
-        except _Stop as stop:
-            status, message = stop.status, stop.message
-            run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
-        return self._result(scene, run, names, status, message, time.process_time() - wall)
+        # A diverging run (huge tolerances, a Painlevé blow-up) overflows inside scipy and the
+        # model: no warnings on stderr, the non-finite samples end the result instead (below).
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                modes = self._decide(scene, 0.0, q, v)
+                run.events.append(Event(0.0, "start", "", {"modes": list(modes)}))
+                status, message = self._loop(scene, run, modes, t_end, names)
+            except _Stop as stop:
+                status, message = stop.status, stop.message
+                run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
+            result = self._result(scene, run, names, status, message, time.process_time() - wall)
+        return _finite_part(result)
 
     def _check_inputs(self, scene, q0, v0, t_end):
         require_positive("t_end", t_end)
