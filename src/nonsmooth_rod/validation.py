@@ -2,7 +2,7 @@
 
 Every check returns the value it checked, converted (a float, an int, a bool), so that the
 caller uses what was checked and never the raw input: a string is not a number, a bool is not a
-number, an integer too large for a float is refused here rather than overflowing later.
+number, an integer beyond the engine's int64 is refused here rather than overflowing later.
 Options dataclasses declare their checks per field (`option(default, Number(...))`) and run
 them all with `check_options(self)`: one check per option, whoever builds the options.
 """
