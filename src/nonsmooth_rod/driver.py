@@ -19,10 +19,12 @@ from . import _jit
 from .integrators import METHODS, integrator_classes, supported_contacts
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
-from .validation import InputError, require_finite, require_positive, require_state
+from .validation import InputError, quoted, require_finite, require_positive, require_state
 
 # Refuse a run whose saved output would exceed this (bytes), before allocating anything.
 MAX_OUTPUT_BYTES = 4 * 2**30
+# A max_step asking scipy for more steps than this is refused (about a minute of stepping).
+MAX_CAPPED_STEPS = 10**6
 
 
 @dataclass(frozen=True)
@@ -37,7 +39,7 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     """Simulate `scene` from (q0, v0) at time t0 to t_end with the named method.
 
     method: "moreau-jean" (options h, theta, solver, solver_options, activation_gamma,
-    min_phase, fast), "event-driven" (rtol, atol, max_step, output_dt, ...) or "regularized"
+    min_phase, fast), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...) or "regularized"
     (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping, time_limit, ...).
     save_every: keep one sample per this many seconds (default: every step / output_dt).
     stop: a contact name or `StopAtImpact(name)` (the run ends at that contact's first
@@ -57,6 +59,7 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     integrator_cls, options_cls = _method(method, scene)
     impact_stops, callables = _stop_conditions(stop, scene)
     opts = _options(options_cls, method, options, impact_stops)
+    _check_step_cap(opts, t_end - t0)
     _check_output_size(method, opts, scene, t_end - t0, save_every)
     run_scene = _shifted(scene, t0)
     if getattr(opts, "fast", False):  # a run that would be compiled: say once if numba is missing
@@ -76,8 +79,8 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
 
 
 def _method(method, scene: Scene):
-    if method not in METHODS:
-        raise InputError(f"unknown method {method!r}; choose from: {', '.join(METHODS)}")
+    if not isinstance(method, str) or method not in METHODS:
+        raise InputError(f"unknown method {quoted(method)}; choose from: {', '.join(METHODS)}")
     handled = supported_contacts(method)
     for contact in scene.contacts:
         if type(contact).__name__ not in handled:
@@ -110,7 +113,7 @@ def _options(options_cls, method: str, options: dict, impact_stops: list):
     valid = [f.name for f in dataclasses.fields(options_cls) if f.name != "stop_at_impact"]
     for key in options:
         if key not in valid:
-            raise InputError(f"unknown option {key!r} for method {method!r}; options: {', '.join(valid)}")
+            raise InputError(f"unknown option {quoted(key)} for method {method!r}; options: {', '.join(valid)}")
     if impact_stops:
         options = dict(options, stop_at_impact=impact_stops[0])
     try:
@@ -119,6 +122,15 @@ def _options(options_cls, method: str, options: dict, impact_stops: list):
         raise
     except (TypeError, ValueError) as err:
         raise InputError(f"invalid option for method {method!r}: {err}") from None
+
+
+def _check_step_cap(opts, duration: float) -> None:
+    """Refuse a step cap (`max_step` of the ODE methods) that makes the run a hang: more than
+    MAX_CAPPED_STEPS steps of scipy's integrators (each tens of microseconds)."""
+    cap = getattr(opts, "max_step", math.inf)
+    if duration / cap > MAX_CAPPED_STEPS:
+        raise InputError(f"max_step = {cap:g} s over a run of {duration:g} s asks for more than "
+                         f"{MAX_CAPPED_STEPS:.0e} ODE steps: use max_step ≥ {duration / MAX_CAPPED_STEPS:.3g} s")
 
 
 def _check_output_size(method: str, opts, scene: Scene, duration: float, save_every) -> None:

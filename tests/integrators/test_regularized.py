@@ -40,8 +40,8 @@ def test_friction_curves_have_their_documented_shape():
 
 
 @pytest.mark.parametrize("bad, match", [
-    (dict(epsilon=0.0), "epsilon"), (dict(friction_curve="coulomb"), "friction curve"),
-    (dict(ode_method="Euler"), "ODE method"), (dict(contact_model="hertz"), "contact model"),
+    (dict(epsilon=0.0), "epsilon"), (dict(friction_curve="coulomb"), "friction_curve"),
+    (dict(ode_method="Euler"), "ode_method"), (dict(contact_model="hertz"), "contact_model"),
     (dict(stiffness=-1.0), "stiffness"), (dict(stribeck_ratio=0.5), "stribeck_ratio"),
 ])
 def test_bad_options_are_one_line_input_errors(bad, match):
@@ -113,4 +113,4 @@ def test_cli_runs_the_regularized_method_and_rejects_a_bad_curve(tmp_path, capsy
     assert summary["impact"]["t"] == pytest.approx(0.375302, abs=5e-4)
     assert main(["simulate", "--method", "regularized", "--friction-curve", "coulomb", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "friction curve" in err[0]
+    assert len(err) == 1 and "friction_curve" in err[0]

@@ -234,3 +234,16 @@ def test_failure_message_names_both_formulations(monkeypatch):
     monkeypatch.setattr(lemke_module, "_default_max_pivots", lambda n: 1)
     with pytest.raises(NoConvergence, match=r"pivot limit 1 .*interval.*; fallback: .*pivot limit 1 .*cone"):
         lemke_friction(problem)
+
+
+@pytest.mark.parametrize("ratio", [1e-9, 1e-12])
+def test_contacts_of_very_different_stiffness_are_solved(ratio):
+    # A light and a heavy body (W blocks 1 and `ratio`), both pushed into contact, no tangential
+    # drive: p_N = −q_N / W_NN and p_T = 0 exactly. Global scaling alone made the heavy contact's
+    # block look like round-off (a wrong impulse accepted with residual 1, or a ray).
+    from nonsmooth_rod.solvers import PlanarFrictionProblem, solve
+
+    W = np.diag([1.0, 1.0, ratio, ratio])
+    problem = PlanarFrictionProblem(W, np.array([-1.0, 0.0, -1.0, 0.0]), np.array([-0.3, -0.3]), np.array([0.3, 0.3]))
+    solution = solve(problem, "lemke")
+    np.testing.assert_allclose(solution.p, [1.0, 0.0, 1.0 / ratio, 0.0], rtol=1e-12, atol=1e-12)

@@ -36,6 +36,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,9 +48,25 @@ from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
-from ..validation import InputError, require_positive, require_state
+from ..solvers import available_solvers
+from ..validation import (
+    Choice,
+    InputError,
+    Integer,
+    Number,
+    Text,
+    check_options,
+    option,
+    require_positive,
+    require_state,
+)
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+# scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
+RTOL_FLOOR = 100 * float(np.finfo(float).eps)
+# An absolute tolerance on positions (m) and velocities (m/s) beyond this is no tolerance: the
+# solver's steps then skip over the events (atol = 1e20 wrote −inf into the trajectory).
+ATOL_CEILING = 1e-2
 MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 
 
@@ -57,28 +74,39 @@ MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 class EventDrivenOptions:
     """Accuracy and stopping controls of the event-driven integrator."""
 
-    rtol: float = 1e-12
-    atol: float = 1e-12
-    method: str = "DOP853"
-    output_dt: float = 1e-3  # spacing of the saved samples (events are always saved)
+    rtol: float = option(1e-12, Number(RTOL_FLOOR, 0.1))
+    atol: float = option(1e-12, Number(0.0, ATOL_CEILING, open_lo=True))
+    ode_method: str = option("DOP853", Choice(ODE_METHODS))
+    # spacing of the saved samples (events are always saved)
+    output_dt: float = option(1e-3, Number(0.0, open_lo=True))
     # Events are found within each step, whatever its length (see `_Watch`): the cap only
     # bounds the step for whoever wants it; infinity (the default) leaves it to the tolerance.
-    max_step: float = math.inf
-    stop_at_impact: str | None = None  # name of a contact whose first impact ends the run
-    max_events: int = 10_000
-    zeno_interval: float = 1e-9  # impacts closer than this in time: an accumulation point
-    impact_solver: str = "enum"
-    gap_tol: float = 1e-9
-    velocity_tol: float = 1e-9
+    max_step: float = option(math.inf, Number(0.0, open_lo=True, infinite=True))
+    stop_at_impact: str | None = option(None, Text())  # name of a contact whose first impact ends the run
+    max_events: int = option(10_000, Integer(1, 10**9))
+    # impacts closer than this in time: an accumulation point (s)
+    zeno_interval: float = option(1e-9, Number(0.0, 1e-3))
+    impact_solver: str = option("enum", Choice(available_solvers))
+    gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
+    velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
 
     def __post_init__(self):
-        require_positive("rtol", self.rtol)
-        require_positive("atol", self.atol)
-        require_positive("output_dt", self.output_dt)
-        if self.method not in ODE_METHODS:
-            raise InputError(f"method must be one of {', '.join(ODE_METHODS)}, got {self.method!r}")
-        if not (isinstance(self.max_step, (int, float)) and self.max_step > 0):  # inf: no cap
-            raise InputError(f"max_step must be positive (inf: no cap), got {self.max_step!r}")
+        check_options(self)
+
+
+def _finite_part(result: SimulationResult) -> SimulationResult:
+    """The result up to its first non-finite sample (q, v, N or T), then status "failed"."""
+    tr = result.trajectory
+    bad = ~(np.all(np.isfinite(tr.q), axis=1) & np.all(np.isfinite(tr.v), axis=1)
+            & np.all(np.isfinite(tr.normal_force), axis=1) & np.all(np.isfinite(tr.tangential_force), axis=1))
+    if not bad.any():
+        return result
+    k = int(np.argmax(bad))
+    t_bad = float(tr.t[k])
+    result.trajectory = Trajectory(tr.t[:k], tr.q[:k], tr.v[:k], tr.a[:k], tr.normal_force[:k],
+                                   tr.tangential_force[:k], tr.modes[:k])
+    result.set_status("failed", f"non-finite state at t = {t_bad:.9g} s (the integration diverged)")
+    return result
 
 
 class _Stop(Exception):
@@ -423,14 +451,19 @@ class EventDriven:
         wall = time.process_time()
         names = [c.name for c in scene.contacts]
         run = _Run(0.0, q, v)
-        try:
-            modes = self._decide(scene, 0.0, q, v)
-            run.events.append(Event(0.0, "start", "", {"modes": list(modes)}))
-            status, message = self._loop(scene, run, modes, t_end, names)
-        except _Stop as stop:
-            status, message = stop.status, stop.message
-            run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
-        return self._result(scene, run, names, status, message, time.process_time() - wall)
+        # A diverging run (huge tolerances, a Painlevé blow-up) overflows inside scipy and the
+        # model: no warnings on stderr, the non-finite samples end the result instead (below).
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                modes = self._decide(scene, 0.0, q, v)
+                run.events.append(Event(0.0, "start", "", {"modes": list(modes)}))
+                status, message = self._loop(scene, run, modes, t_end, names)
+            except _Stop as stop:
+                status, message = stop.status, stop.message
+                run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
+            result = self._result(scene, run, names, status, message, time.process_time() - wall)
+        return _finite_part(result)
 
     def _check_inputs(self, scene, q0, v0, t_end):
         require_positive("t_end", t_end)
@@ -473,7 +506,7 @@ class EventDriven:
         def rhs(t, y):
             return np.concatenate([y[n:], mode_dynamics(scene, t, y[:n], y[n:], frozen).a])
         o = self.options
-        return getattr(scipy.integrate, o.method)(rhs, t0, y0, t_end, rtol=o.rtol, atol=o.atol,
+        return getattr(scipy.integrate, o.ode_method)(rhs, t0, y0, t_end, rtol=o.rtol, atol=o.atol,
                                                   max_step=o.max_step)
 
     def _segment(self, scene, run, modes, t_end):

@@ -18,7 +18,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
@@ -27,11 +27,11 @@ from .. import _jit
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
-from ..solvers import available_solvers
+from ..solvers import available_solvers, check_solver_options
 from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
-from ..validation import InputError, require_in_range, require_positive, require_state
+from ..validation import Choice, Flag, InputError, Number, Text, check_options, option, require_positive, require_state
 from . import moreau_jean_loop as loop
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 
@@ -45,31 +45,27 @@ DEFAULT_RTOL, DEFAULT_MAX_ITER = 0.0, 0
 class MoreauJeanOptions:
     """Step size, θ of the θ-method, contact activation and the one-step solver."""
 
-    h: float = 1e-4
-    theta: float = 0.5
-    activation_gamma: float = 0.5  # a contact enters the step when g + γ h u_N ≤ 0
-    solver: str = "lemke"
-    solver_options: dict = field(default_factory=dict)
-    stop_at_impact: str | None = None  # name of a contact whose first impact ends the run
-    min_phase: float | None = None  # phases shorter than this are merged (default 2h)
-    allow_energy_gain: bool = False  # θ < ½ amplifies energy; refused unless asked for
-    fast: bool = True  # use the compiled loop when the scene and solver allow it
+    h: float = option(1e-4, Number(0.0, open_lo=True), label="h (step size)")
+    theta: float = option(0.5, Number(0.0, 1.0))
+    # a contact enters the step when g + γ h u_N ≤ 0
+    activation_gamma: float = option(0.5, Number(0.0, 1.0), label="activation_gamma")
+    solver: str = option("lemke", Choice(available_solvers))
+    solver_options: dict = option(None, None, default_factory=dict)  # checked per solver below
+    stop_at_impact: str | None = option(None, Text())  # name of a contact whose first impact ends the run
+    min_phase: float | None = option(None, Number(0.0, optional=True))  # shorter phases are merged (default 2h)
+    allow_energy_gain: bool = option(False, Flag())  # θ < ½ amplifies energy; refused unless asked for
+    fast: bool = option(True, Flag())  # use the compiled loop when the scene and solver allow it
 
     def __post_init__(self):
-        require_positive("h (step size)", self.h)
-        require_in_range("theta", self.theta, 0.0, 1.0)
-        require_in_range("activation gamma", self.activation_gamma, 0.0, 1.0)
+        check_options(self)
+        self.solver_options = check_solver_options(self.solver, self.solver_options)
         if self.theta < 0.5 and not self.allow_energy_gain:
             raise InputError(
                 f"theta = {self.theta:g} < 0.5 makes Moreau–Jean gain energy; use theta in [0.5, 1] "
                 "(or allow_energy_gain=True to study it)"
             )
-        if self.solver not in available_solvers():
-            raise InputError(f"unknown solver '{self.solver}'; choose from: {', '.join(available_solvers())}")
         if self.min_phase is None:
             self.min_phase = 2 * self.h
-        elif self.min_phase < 0:
-            raise InputError(f"min_phase must be non-negative, got {self.min_phase!r}")
 
 
 _ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")

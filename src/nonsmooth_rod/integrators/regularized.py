@@ -50,7 +50,8 @@ from scipy.optimize import brentq
 from ..model.contacts import DiskOnLine
 from ..model.scene import Scene
 from ..results import Event, Impact, SimulationResult, Trajectory, merge_short_phases, Phase
-from ..validation import InputError, require_nonnegative, require_positive
+from ..validation import Choice, InputError, Number, Text, check_options, option, require_positive
+from .event_driven import ATOL_CEILING, RTOL_FLOOR
 
 FRICTION_CURVES = ("stribeck", "tanh", "linear")
 ODE_METHODS = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA, "RK23": RK23}
@@ -59,6 +60,11 @@ CONTACT_MODELS = ("hunt-crossley", "spring-damper")
 
 HERTZ_STEEL_STIFFNESS = 2.0e10  # N/m^1.5: (4/3) E* √R, E* = 1.15e11 Pa, R = 20 mm
 DEFAULT_HC_DAMPING = 500.0  # s/m (α of Hunt–Crossley)
+# Penalty parameters within which the contact force k δ^n (1 + α δ̇) stays far from overflow
+# for penetrations and speeds the run can reach (beyond, k = 1e300 gave a "math domain error"
+# or |q| ≈ 1e239 with status ok).
+STIFFNESS_RANGE = (1.0, 1e15)
+DAMPING_RANGE = (0.0, 1e9)
 
 
 def _cubic_step(x: float, x0: float, x1: float) -> float:
@@ -92,52 +98,37 @@ def friction_coefficient(curve: str, v: float, eps: float, mu_s: float, mu_d: fl
 class RegularizedOptions:
     """Regularised friction, penalty contact, and the ODE integrator that runs them."""
 
-    epsilon: float = 1e-4  # regularisation (stiction transition) velocity, m/s
-    friction_curve: str = "stribeck"
-    stribeck_ratio: float = 10.0  # friction transition velocity / ε (Stribeck curve only)
-    ode_method: str = "RK45"
-    rtol: float = 1e-6
-    atol: float = 1e-9
-    contact_model: str = "hunt-crossley"
-    stiffness: float = HERTZ_STEEL_STIFFNESS
-    exponent: float = 1.5  # Hunt–Crossley only
-    damping: float | None = None  # α [s/m] (Hunt–Crossley) or c [N·s/m] (spring–damper)
-    stick_velocity: float = 1e-4  # |u_T| below this counts as stick in the output, m/s
-    min_phase: float = 1e-3  # s
-    output_dt: float = 1e-3  # spacing of saved samples, s
-    stop_at_impact: str | None = None  # name of a contact whose first touchdown ends the run
-    time_limit: float | None = None  # wall-clock seconds; then status "time-limit"
-    max_penetration: float = 1e-3  # m; deeper: status "penetration"
-    first_step: float | None = None
-    max_step: float = math.inf
+    # regularisation (stiction transition) velocity, m/s
+    epsilon: float = option(1e-4, Number(1e-12, 10.0), label="epsilon (regularisation velocity)")
+    friction_curve: str = option("stribeck", Choice(FRICTION_CURVES))
+    # friction transition velocity / ε (Stribeck curve only)
+    stribeck_ratio: float = option(10.0, Number(1.0, 1e6, open_lo=True))
+    ode_method: str = option("RK45", Choice(tuple(ODE_METHODS)))
+    rtol: float = option(1e-6, Number(RTOL_FLOOR, 0.1))
+    atol: float = option(1e-9, Number(0.0, ATOL_CEILING, open_lo=True))
+    contact_model: str = option("hunt-crossley", Choice(CONTACT_MODELS))
+    stiffness: float = option(HERTZ_STEEL_STIFFNESS, Number(*STIFFNESS_RANGE))
+    exponent: float = option(1.5, Number(1.0, 3.0))  # Hunt–Crossley only
+    # α [s/m] (Hunt–Crossley) or c [N·s/m] (spring–damper)
+    damping: float | None = option(None, Number(*DAMPING_RANGE, optional=True))
+    # |u_T| below this counts as stick in the output, m/s
+    stick_velocity: float = option(1e-4, Number(0.0, 1.0, open_lo=True), label="stick velocity")
+    min_phase: float = option(1e-3, Number(0.0))  # s
+    output_dt: float = option(1e-3, Number(0.0, open_lo=True))  # spacing of saved samples, s
+    # name of a contact whose first touchdown ends the run
+    stop_at_impact: str | None = option(None, Text())
+    # wall-clock seconds; then status "time-limit"
+    time_limit: float | None = option(None, Number(0.0, open_lo=True, optional=True))
+    max_penetration: float = option(1e-3, Number(0.0, 1.0, open_lo=True))  # m; deeper: status "penetration"
+    first_step: float | None = option(None, Number(0.0, open_lo=True, optional=True))
+    max_step: float = option(math.inf, Number(0.0, open_lo=True, infinite=True))
 
     def __post_init__(self):
-        require_positive("epsilon (regularisation velocity)", self.epsilon)
-        require_positive("rtol", self.rtol)
-        require_positive("atol", self.atol)
-        require_positive("stiffness", self.stiffness)
-        require_positive("exponent", self.exponent)
-        require_positive("stick velocity", self.stick_velocity)
-        require_nonnegative("min_phase", self.min_phase)
-        require_positive("output_dt", self.output_dt)
-        require_positive("max_penetration", self.max_penetration)
-        if self.stribeck_ratio <= 1.0:
-            raise InputError(f"stribeck_ratio must exceed 1, got {self.stribeck_ratio!r}")
-        if self.friction_curve not in FRICTION_CURVES:
-            raise InputError(f"unknown friction curve '{self.friction_curve}'; "
-                             f"choose from: {', '.join(FRICTION_CURVES)}")
-        if self.ode_method not in ODE_METHODS:
-            raise InputError(f"unknown ODE method '{self.ode_method}'; choose from: {', '.join(ODE_METHODS)}")
-        if self.contact_model not in CONTACT_MODELS:
-            raise InputError(f"unknown contact model '{self.contact_model}'; "
-                             f"choose from: {', '.join(CONTACT_MODELS)}")
+        check_options(self)
         if self.damping is None:
             # Spring–damper: critical-ish damping of a 0.3 kg body on the default spring.
             self.damping = DEFAULT_HC_DAMPING if self.contact_model == "hunt-crossley" else 2.0 * math.sqrt(
                 self.stiffness * 0.3)
-        require_nonnegative("damping", self.damping)
-        if self.time_limit is not None:
-            require_positive("time_limit", self.time_limit)
 
 
 class _TimeLimit(Exception):

@@ -19,7 +19,7 @@ import numpy as np
 
 from .._jit import jit
 from ..solvers._common import interpreted
-from ..validation import InputError, require_finite, require_nonnegative
+from ..validation import InputError, quoted, require_finite, require_nonnegative
 
 # Force kinds of the packed table.
 FORCE_SPRING, FORCE_CONSTANT, FORCE_RAMPED, FORCE_TABULATED = 0, 1, 2, 3
@@ -34,7 +34,7 @@ N_FORCE_INDEX_COLUMNS = 5
 
 def _require_body(owner: str, field_name: str, body) -> int:
     if isinstance(body, bool) or not isinstance(body, (int, np.integer)) or body < 0:
-        raise InputError(f"{owner} {field_name} must be a non-negative body index, got {body!r}")
+        raise InputError(f"{owner} {field_name} must be a non-negative body index, got {quoted(body)}")
     return int(body)
 
 
@@ -42,7 +42,7 @@ def _require_point(owner: str, field_name: str, point) -> tuple[float, float]:
     try:
         x, y = point
     except (TypeError, ValueError):
-        raise InputError(f"{owner} {field_name} must be a pair (x, y), got {point!r}") from None
+        raise InputError(f"{owner} {field_name} must be a pair (x, y), got {quoted(point)}") from None
     return (require_finite(f"{owner} {field_name}", x), require_finite(f"{owner} {field_name}", y))
 
 
@@ -135,7 +135,7 @@ class RampedForce(_Force):
         require_finite(f"{self.name} t_start", self.t_start)
         require_finite(f"{self.name} t_full", self.t_full)
         if not self.t_full > self.t_start:
-            raise InputError(f"{self.name} t_full must exceed t_start = {self.t_start!r}, got {self.t_full!r}")
+            raise InputError(f"{self.name} t_full must exceed t_start = {quoted(self.t_start)}, got {quoted(self.t_full)}")
 
 
 @dataclass(frozen=True)
@@ -155,15 +155,15 @@ class TabulatedForce(_Force):
         object.__setattr__(self, "point", _require_point(self.name, "point", self.point))
         times = np.asarray(self.times, dtype=float).ravel()
         if times.size == 0 or not np.all(np.isfinite(times)):
-            raise InputError(f"{self.name} times must be a non-empty sequence of finite numbers, got {self.times!r}")
+            raise InputError(f"{self.name} times must be a non-empty sequence of finite numbers, got {quoted(self.times)}")
         if np.any(np.diff(times) <= 0.0):
-            raise InputError(f"{self.name} times must be strictly increasing, got {self.times!r}")
+            raise InputError(f"{self.name} times must be strictly increasing, got {quoted(self.times)}")
         forces = np.asarray(self.forces, dtype=float)
         if forces.shape != (times.size, 2) or not np.all(np.isfinite(forces)):
-            raise InputError(f"{self.name} forces must be {times.size} finite (fx, fy) rows, got {self.forces!r}")
+            raise InputError(f"{self.name} forces must be {times.size} finite (fx, fy) rows, got {quoted(self.forces)}")
         torques = np.zeros(times.size) if self.torques is None else np.asarray(self.torques, dtype=float).ravel()
         if torques.shape != (times.size,) or not np.all(np.isfinite(torques)):
-            raise InputError(f"{self.name} torques must be {times.size} finite numbers, got {self.torques!r}")
+            raise InputError(f"{self.name} torques must be {times.size} finite numbers, got {quoted(self.torques)}")
         object.__setattr__(self, "times", tuple(times.tolist()))
         object.__setattr__(self, "forces", tuple(map(tuple, forces.tolist())))
         object.__setattr__(self, "torques", tuple(torques.tolist()))

@@ -6,7 +6,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..validation import InputError, require_finite
+from ..validation import InputError, quoted, require_finite, require_name
 from .body import RigidBody
 
 AppliedForce = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -29,7 +29,7 @@ class Scene:
     def __post_init__(self):
         require_finite("g", self.gravity)
         if self.gravity < 0:
-            raise InputError(f"g must be non-negative, got {self.gravity!r}")
+            raise InputError(f"g must be non-negative, got {quoted(self.gravity)}")
         if not self.bodies:
             raise InputError("a scene needs at least one body")
         self.bodies = list(self.bodies)
@@ -54,6 +54,7 @@ class Scene:
         for body in self.bodies:
             if not isinstance(body, RigidBody):
                 raise InputError(f"scene bodies must be RigidBody, got {type(body).__name__}")
+            require_name("a body's name", body.name)
         seen = set()
         for contact in self.contacts:
             if not hasattr(contact, "bodies") or not hasattr(contact, "kinematics"):
@@ -63,10 +64,12 @@ class Scene:
                 if body >= len(self.bodies):
                     raise InputError(f"contact {contact.name!r} refers to body {body}, but the scene has "
                                      f"{len(self.bodies)} bodies (0 to {len(self.bodies) - 1})")
+            require_name("a contact's name", contact.name)  # it heads CSV columns: no newline in it
             if contact.name in seen:
                 raise InputError(f"two contacts are named {contact.name!r}: contact names must be unique")
             seen.add(contact.name)
         for i, force in enumerate(self.forces):
+            require_name(f"forces[{i}] name", force.name)
             for attr in ("body", "body_a", "body_b"):
                 body = getattr(force, attr, None)
                 if body is not None and body >= len(self.bodies):

@@ -15,7 +15,9 @@ optional extra, imported only when a QP solver is listed or used.
 """
 from __future__ import annotations
 
-from ..validation import InputError
+from collections.abc import Mapping
+
+from ..validation import InputError, Integer, Number, quoted
 from .problem import (
     ContactSolution,
     InfeasibleProblem,
@@ -68,6 +70,43 @@ def available_solvers() -> list[str]:
     return names
 
 
+# The settings each solver takes inside Moreau–Jean (`solver_options`), with their checks: the
+# compiled kernels read tol (relative residual) and max_iter (Lemke's pivots, pgs's sweeps; enum
+# has none); the QP solvers take theirs plus the backend's own settings (scalars, by name).
+_TOL = Number(0.0, 1.0, open_lo=True)
+SOLVER_SETTINGS = {
+    "lemke": {"tol": _TOL, "max_iter": Integer(1, 10**9)},
+    "pgs": {"tol": _TOL, "max_iter": Integer(1, 10**9)},
+    "enum": {"tol": _TOL},
+}
+QP_SETTINGS = {"tol": _TOL, "max_iter": Integer(1, 10**6), "check_tol": _TOL}
+RELAXED_QP_SETTINGS = {"check_tol": _TOL}
+
+
+def check_solver_options(solver: str, options) -> dict:
+    """`solver_options` of the named solver, checked key by key (InputError naming the key):
+    a table of known settings, each a number in its range; QP backends' own settings pass
+    through by name if they are plain scalars (the backend checks their values)."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise InputError(f"solver_options must be a table of settings (e.g. {{tol = 1e-10}}), got {quoted(options)}")
+    exact = solver in SOLVER_SETTINGS
+    settings = SOLVER_SETTINGS.get(solver) or (RELAXED_QP_SETTINGS if solver.endswith("-relaxed") else QP_SETTINGS)
+    checked = {}
+    for key, value in options.items():
+        if key in settings:
+            checked[key] = settings[key](f"solver_options.{key}", value)
+        elif exact or not (isinstance(key, str) and key.isidentifier()):
+            raise InputError(f"solver_options: unknown setting {quoted(key)} for solver {solver!r}; "
+                             f"it takes: {', '.join(settings) or 'none'}")
+        elif isinstance(value, bool) or (isinstance(value, str) and value.isprintable()):
+            checked[key] = value
+        else:
+            checked[key] = Number()(f"solver_options.{key}", value)
+    return checked
+
+
 def solve(problem: PlanarFrictionProblem, solver: str = "lemke", **options) -> ContactSolution:
     """Solve one step's contact problem with the named solver.
 
@@ -98,6 +137,7 @@ def solve(problem: PlanarFrictionProblem, solver: str = "lemke", **options) -> C
 __all__ = [
     "solve",
     "available_solvers",
+    "check_solver_options",
     "ContactSolution",
     "PlanarFrictionProblem",
     "SolverError",

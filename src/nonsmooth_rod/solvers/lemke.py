@@ -46,11 +46,13 @@ Moreau–Jean loop reaches them through `kernels.solve_interval`.
 """
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit
-from ..validation import InputError
+from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
 from .kernel_base import step_residual
 from .problem import (
@@ -62,8 +64,13 @@ from .problem import (
     classify_contacts,
 )
 
-# Kernel status codes.
-SOLVED, RAY, PIVOT_LIMIT = 0, 1, 2
+# Kernel status codes (the generic LCP adds TIME_LIMIT, OVERFLOW, INACCURATE, decided in Python).
+SOLVED, RAY, PIVOT_LIMIT, TIME_LIMIT, OVERFLOW, INACCURATE = 0, 1, 2, 3, 4, 5
+MAX_PIVOTS = 10**12  # a pivot limit beyond this is no limit (and must fit the kernels' int64)
+EQUILIBRATION_SWEEPS = 64  # Ruiz sweeps: each halves the binary exponents, 1e±308 needs ~11
+ACCURACY = 1e-9  # a generic LCP's solution: w ≥ 0 and z·w = 0 to this, relative to each row's scale
+ROUNDOFF_FLOOR = 1e-12  # ... or to this relative to the whole problem's (ties are 1e-14 apart)
+CHUNK_WORK = 2e7  # flops of pivoting between two readings of the clock (~10 ms compiled)
 # Friction LCP formulations.
 INTERVAL, CONE = 0, 1
 FORMULATIONS = {"interval": INTERVAL, "cone": CONE}
@@ -174,7 +181,8 @@ def _complementary_pivoting(T, basis, n, max_pivots):
 
     Variables are numbered w_0..w_{n−1} = 0..n−1, z_0..z_{n−1} = n..2n−1, z0 (artificial) = 2n.
     Returns (status, pivots, last entering variable). On SOLVED the basic variables are in
-    basis/T[:, rhs]; q ≥ 0 returns SOLVED after 0 pivots (z = 0).
+    basis/T[:, rhs]; q ≥ 0 returns SOLVED after 0 pivots (z = 0). On PIVOT_LIMIT (with
+    pivots ≥ 1) `_resume_pivoting` continues where it stopped.
     """
     z0 = 2 * n
     rhs = 2 * n + 1
@@ -184,11 +192,21 @@ def _complementary_pivoting(T, basis, n, max_pivots):
     if max_pivots < 1:
         return PIVOT_LIMIT, 0, z0
     _pivot(T, r, z0)
-    z0_row = r
     leaving = basis[r]
     basis[r] = z0
-    pivots = 1
-    entering = leaving + n  # complement of the w that just left
+    return _resume_pivoting(T, basis, n, leaving + n, 1, max_pivots)
+
+
+@jit
+def _resume_pivoting(T, basis, n, entering, pivots, max_pivots):
+    """The pivoting loop from `entering` (the complement of the variable that left last), after
+    `pivots` pivots, up to max_pivots in all: (status, pivots, entering)."""
+    z0 = 2 * n
+    rhs = 2 * n + 1
+    z0_row = np.int64(0)
+    for i in range(n):
+        if basis[i] == z0:
+            z0_row = i
     while True:
         column_max = 1.0
         for i in range(n):
@@ -323,6 +341,32 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
 
 
 @jit
+def _contact_scales(W, n_c):
+    """Per contact the power of two nearest 1/√max(W_NN, W_TT) (1 for a zero block)."""
+    d = np.ones(n_c)
+    for c in range(n_c):
+        diagonal = max(abs(W[2 * c][2 * c]), abs(W[2 * c + 1][2 * c + 1]))
+        if diagonal > 0.0:
+            d[c] = 2.0 ** (-np.round(0.5 * np.log2(diagonal)))
+    return d
+
+
+@jit
+def _scaled_step(W, q, d, Ws, qs):
+    """Ws = D W D, qs = D q; returns (max|W|, max|q|, max|Ws| or 1, max|qs| or 1)."""
+    W_norm, q_norm, ws_norm, qs_norm = 0.0, 0.0, 0.0, 0.0
+    for i in range(q.shape[0]):
+        q_norm = max(q_norm, abs(q[i]))
+        qs[i] = q[i] * d[i // 2]
+        qs_norm = max(qs_norm, abs(qs[i]))
+        for j in range(q.shape[0]):
+            W_norm = max(W_norm, abs(W[i][j]))
+            Ws[i][j] = W[i][j] * d[i // 2] * d[j // 2]
+            ws_norm = max(ws_norm, abs(Ws[i][j]))
+    return W_norm, q_norm, (ws_norm if ws_norm > 0.0 else 1.0), (qs_norm if qs_norm > 0.0 else 1.0)
+
+
+@jit
 def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms).
 
@@ -330,34 +374,32 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     states (computed here, they cost nothing; in Python after the call, microseconds).
 
     ``formulation``: INTERVAL (3 unknowns per contact) or CONE (4 per contact). The LCP is
-    built from W / max|W| and q / max|q| so that the pivoting tolerances act on O(1)
-    numbers; p = p̃ · max|q| / max|W| undoes it exactly (u scales with max|q|).
+    built from D W D and D q, D = diag(d_c) per contact (both rows of a contact alike, which
+    leaves its friction interval as it is; d_c a power of two near 1/√W_cc: exact), then
+    divided by max|D W D| and max|D q|, so that the pivoting tolerances act on O(1) numbers
+    even when the contacts' W blocks differ by 1e12 (a heavy and a light body); p = D p̃ ·
+    max|D q| / max|D W D| undoes it exactly.
     """
     n_c = len(lo)
-    W_norm = 0.0
-    q_norm = 0.0
-    for i in range(2 * n_c):
-        q_norm = max(q_norm, abs(q[i]))
-        for j in range(2 * n_c):
-            W_norm = max(W_norm, abs(W[i][j]))
-    w_scale = W_norm if W_norm > 0.0 else 1.0
-    q_scale = q_norm if q_norm > 0.0 else 1.0
+    d = _contact_scales(W, n_c)
+    Ws, qs = np.empty((2 * n_c, 2 * n_c)), np.empty(2 * n_c)
+    W_norm, q_norm, w_scale, q_scale = _scaled_step(W, q, d, Ws, qs)
     per_contact = 3 if formulation == INTERVAL else 4
     n = per_contact * n_c
     M = np.zeros((n, n))
     qq = np.zeros(n)
     if formulation == INTERVAL:
-        _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
+        _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
-        _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale)
+        _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     z, status, pivots, entering = _lemke_kernel(M, qq, max_pivots)
 
     p = np.zeros(2 * n_c)
     u = np.zeros(2 * n_c)
     residual = 0.0
     if status == SOLVED or status == RAY:
-        to_impulse = q_scale / w_scale
         for j in range(n_c):
+            to_impulse = d[j] * q_scale / w_scale
             k = per_contact * j
             p[2 * j] = z[k] * to_impulse
             if formulation == INTERVAL:
@@ -416,7 +458,7 @@ def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
     NoConvergence when ``max_pivots`` (default 50 + 20 n) is reached.
     `nonsmooth_rod.solvers.lcp.lemke` is the same method reporting failure as a status.
     """
-    z, status, pivots, entering, max_pivots = run_lemke(M, q, max_pivots, jit)
+    z, _, status, pivots, entering, max_pivots = run_lemke(M, q, max_pivots, jit)
     n = z.shape[0]
     if status == RAY:
         raise RayTermination(
@@ -425,34 +467,140 @@ def lemke(M, q, max_pivots: int | None = None, *, jit: bool | None = None):
         )
     if status == PIVOT_LIMIT:
         raise NoConvergence(f"lemke: pivot limit {max_pivots} reached on an LCP of size {n}")
+    if status == INACCURATE:
+        raise NoConvergence(f"lemke: no solution of the LCP of size {n} accurate to {ACCURACY:g} was reached")
+    if status == OVERFLOW:
+        raise NoConvergence(f"lemke: the solution of the LCP of size {n} overflows float64 (|z| > 1.8e308)")
     return z, pivots
 
 
-def run_lemke(M, q, max_pivots: int | None, jit: bool | None):
-    """Validate (M, q), scale, pivot: (z, status, pivots, last entering, max_pivots used)."""
+def run_lemke(M, q, max_pivots: int | None, jit: bool | None, time_limit: float | None = None):
+    """Validate (M, q), equilibrate, pivot: (z, w, status, pivots, last entering, max_pivots used).
+
+    The LCP solved is an equilibrated one, D_r M D_c z' + D_r q (D_r, D_c positive diagonal,
+    powers of two: exact), whose solution gives z = D_c z'. First D_r, D_c balance M's rows
+    and columns; if that solution fails `_accurate` (or ends on a ray), a second pass takes
+    D_r from q (every nonzero q_i of size one) and D_c from the columns: a P-matrix with
+    entries from 1e-200 to 1e200 then solves as the identity does. The pivots run in chunks
+    so that `time_limit` (wall seconds) is read between them (TIME_LIMIT). A solution beyond
+    float64 (a tiny M with a huge q) is OVERFLOW; one that fails `_accurate` both ways INACCURATE.
+    """
+    M, q = _checked_lcp(M, q)
+    n = q.shape[0]
+    max_pivots = _default_max_pivots(n) if max_pivots is None else require_integer(
+        "lemke: max_pivots", max_pivots, 0, MAX_PIVOTS)
+    if time_limit is not None:
+        time_limit = require_positive("lemke: time_limit", time_limit)
+    deadline = None if time_limit is None else time.monotonic() + time_limit
+    first = _scaled_solve(M, q, False, max_pivots, deadline, _use_jit(jit))
+    if first[2] in (SOLVED, RAY) and not _accurate(M, q, first[0], first[1]):
+        second = _scaled_solve(M, q, True, max_pivots, deadline, _use_jit(jit))
+        if second[2] == SOLVED and _accurate(M, q, second[0], second[1]):
+            return (*second, max_pivots)
+        if first[2] == SOLVED and np.all(np.isfinite(first[0])):
+            first = (*first[:2], INACCURATE, *first[3:])
+    return (*first, max_pivots)
+
+
+def _scaled_solve(M, q, by_q: bool, max_pivots, deadline, compiled):
+    """(z, w, status, pivots, entering) of Lemke on the equilibrated LCP, in M and q's units."""
+    row, col, q_unit = _equilibration(M, q, by_q)
+    status, pivots, entering, z_scaled = _pivot_in_chunks(row[:, None] * M * col[None, :], row * (q / q_unit),
+                                                          max_pivots, deadline, compiled)
+    with np.errstate(all="ignore"):
+        z = col * z_scaled * q_unit
+        w = M @ z + q
+    if status == SOLVED and not (np.all(np.isfinite(z)) and np.all(np.isfinite(w))):
+        status = OVERFLOW
+    return z, w, status, pivots, entering
+
+
+def _accurate(M, q, z, w) -> bool:
+    """Does z solve the LCP to ACCURACY relative to each row's own scale |q_i| + Σ|M_ij z_j|,
+    or to round-off (ROUNDOFF_FLOOR) of the whole problem's scale?"""
+    with np.errstate(all="ignore"):
+        scale = np.abs(q) + np.abs(M) @ np.abs(z)
+        violation = np.maximum(-w, 0.0) + np.where(z > 0.0, np.abs(w), 0.0)
+        allowed = ACCURACY * scale + ROUNDOFF_FLOOR * np.max(scale)
+        return bool(np.all(np.isfinite(z)) and np.all(violation <= allowed))
+
+
+def _checked_lcp(M, q):
+    """M (n × n) and q (n), n ≥ 1, finite floats, or InputError naming the argument."""
     M = _float_array("M", M, 2)
     q = _float_array("q", q, 1)
     n = q.shape[0]
     if q.ndim != 1 or M.shape != (n, n):
         raise InputError(f"lemke: M must be {n}×{n} for q of length {n}, got M {M.shape}, q {q.shape}")
+    if n == 0:
+        raise InputError("lemke: M and q are empty: an LCP needs at least one unknown")
     require_finite_array("M", M, "lemke")
     require_finite_array("q", q, "lemke")
-    if max_pivots is None:
-        max_pivots = _default_max_pivots(n)
-    if isinstance(max_pivots, bool) or not isinstance(max_pivots, (int, np.integer)) or max_pivots < 0:
-        raise InputError(f"lemke: max_pivots must be a non-negative integer, got {max_pivots!r}")
-    m_scale = float(np.max(np.abs(M), initial=0.0)) or 1.0
-    q_scale = float(np.max(np.abs(q), initial=0.0)) or 1.0
-    kernel = _lemke_kernel if _use_jit(jit) else interpreted(_lemke_kernel)
-    z, status, pivots, entering = kernel(M / m_scale, q / q_scale, int(max_pivots))
-    return np.asarray(z, dtype=float) * (q_scale / m_scale), status, pivots, entering, max_pivots
+    return M, q
+
+
+def _equilibration(M, q, by_q: bool = False):
+    """(row, col, q_unit), row and col powers of two. By M (Ruiz's alternating square-root
+    scaling): every row and column of row·|M|·col of max in [½, 2); by q: row_i = 1/|q_i| (to
+    a power of two; rows with q_i = 0 keep M's scaling), then the columns of max in [½, 2).
+    q_unit: the power of two that brings row·q to size one. Zero rows and columns stay 1."""
+    n = q.shape[0]
+    row, col = np.ones(n), np.ones(n)
+    magnitude = np.abs(M)
+    for _ in range(EQUILIBRATION_SWEEPS):
+        row_shift = _half_exponent((magnitude * row[:, None] * col[None, :]).max(axis=1))
+        row = np.ldexp(row, row_shift)
+        col_shift = _half_exponent((magnitude * row[:, None] * col[None, :]).max(axis=0))
+        col = np.ldexp(col, col_shift)
+        if not (row_shift.any() or col_shift.any()):
+            break
+    if by_q:
+        nonzero = q != 0.0
+        row[nonzero] = np.ldexp(1.0, -np.frexp(np.abs(q[nonzero]))[1])
+        col = np.ones(n)
+        col_shift = 2 * _half_exponent((magnitude * row[:, None]).max(axis=0))
+        col = np.ldexp(col, col_shift)
+    with np.errstate(all="ignore"):
+        q_max = float(np.max(np.abs(row * q)))
+    if not np.isfinite(q_max):  # row·q overflows: bring q down first
+        return row, col, float(np.ldexp(1.0, np.frexp(np.max(np.abs(q)))[1]))
+    return row, col, (float(np.ldexp(0.5, np.frexp(q_max)[1])) if q_max > 0.0 else 1.0)
+
+
+def _half_exponent(maxima):
+    """−(binary exponent)/2 of each positive maximum (0 for zero, or when already in [½, 2))."""
+    exponent = np.frexp(maxima)[1].astype(np.int64)
+    return np.where(maxima > 0.0, -(exponent // 2), 0)
+
+
+def _pivot_in_chunks(M, q, max_pivots, deadline, compiled):
+    """Lemke on (M, q) in chunks of about CHUNK_WORK flops (compiled; a hundredth of that
+    interpreted), the clock read between chunks: (status, pivots, entering, z)."""
+    kernels = [k if compiled else interpreted(k) for k in (_fill_tableau, _complementary_pivoting,
+                                                          _resume_pivoting, _basic_solution)]
+    fill, start, resume, basic_solution = kernels
+    n = q.shape[0]
+    T = np.zeros((n, 2 * n + 2))
+    fill(T, M, q, n)
+    basis = np.arange(n)
+    chunk = max(1, int(CHUNK_WORK / (1 if compiled else 100) / (n * (2 * n + 2))))
+    status, pivots, entering = start(T, basis, n, min(chunk, max_pivots))
+    while status == PIVOT_LIMIT and 0 < pivots < max_pivots:
+        if deadline is not None and time.monotonic() > deadline:
+            status = TIME_LIMIT
+            break
+        status, pivots, entering = resume(T, basis, n, entering, pivots, min(pivots + chunk, max_pivots))
+    z = np.zeros(n)
+    if status == SOLVED or status == RAY:  # at a ray z is the last point of the path
+        basic_solution(T, basis, M, q, n, z)
+    return int(status), int(pivots), int(entering), z
 
 
 def _float_array(name, values, ndmin):
     try:
         return np.array(values, dtype=float, ndmin=ndmin)
     except (TypeError, ValueError):
-        raise InputError(f"lemke: {name} must be an array of numbers, got {values!r}") from None
+        raise InputError(f"lemke: {name} must be an array of numbers, got {quoted(values)}") from None
 
 
 def _use_jit(jit: bool | None) -> bool:

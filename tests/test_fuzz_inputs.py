@@ -1,0 +1,42 @@
+"""The fuzzing battery of issue 29 in the suite: seeded mutants of the ten example scenes through
+`nonsmooth-rod run` (in-process, a few as real commands), each a clean refusal (exit 2, one line)
+or a plausible run (finite, ok or a failure said in one line, ending at t_end) — never a
+traceback, a hang or a wrong ok. The larger battery: python benchmarks/fuzz_inputs.py."""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "fuzz_inputs.py"
+# The run ending exactly at t_end (h > t_end, the last step overshooting) is issue 29's run-loop
+# part, fixed on its own branch; until that is merged such mutants are the only ones allowed to
+# fail, and then as an expected failure, so the test starts passing outright once it is.
+OVERSHOOT = "status ok but the last sample is at"
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("fuzz_inputs", BENCH)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_mutants_of_the_examples_are_refused_cleanly_or_run_plausibly():
+    results = _bench().battery(seed=29, count=200, subprocesses=3)
+    others = [f for f in results["failures"] if OVERSHOOT not in f]
+    assert not others, "\n".join(others)
+    assert results["refused"] > 50 and results["ran"] > 20  # the battery exercises both outcomes
+    if results["failures"]:
+        pytest.xfail("runs overshooting t_end (the run-loop branch): " + "; ".join(results["failures"]))
+
+
+def test_the_generator_is_seeded_and_bounded():
+    bench = _bench()
+    first, again = bench.mutants(5, 30), bench.mutants(5, 30)
+    assert [d for _, _, d in first] == [d for _, _, d in again]
+    for _, data, description in first:
+        sim = data.get("simulation")
+        if isinstance(sim, dict) and "t_end" not in description and isinstance(sim.get("t_end"), float):
+            assert sim["t_end"] <= bench.T_END_CAP
