@@ -301,24 +301,35 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
 
 
 @jit
-def _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates):
-    """Contacts that started the step at rest (guess 0), touch at its end (u_N = 0, or u_N equal to
-    the gap-closing velocity) and slide: they must be held if any admissible split can hold them.
-    Returns how many."""
-    n = 0
+def _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release):
+    """Contacts that started the step at rest (guess 0) and touch at its end (u_N = 0, or u_N equal
+    to the gap-closing velocity), sliding (or touching with no impulse) or sticking: the step's choice among its admissible
+    solutions is a choice of which of them stick. `release` gets the slip sign each would slide
+    with when not held: its own slip direction, or for a sticking one the direction its friction
+    opposes (a sticking contact with no friction has no direction and is not a candidate).
+    Returns how many; 0 when none of them slides (the solver's answer holds them all)."""
+    n, sliding = 0, False
     for i in range(start_guess.shape[0]):
         touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
-        if states[i] != STATE_STICK and start_guess[i] == 0.0 and touching \
-                and abs(u[2 * i + 1]) > velocity_tol:
-            candidates[n] = i
-            n += 1
-    return n
+        if start_guess[i] != 0.0 or not touching:
+            continue
+        if abs(u[2 * i + 1]) > velocity_tol:
+            release[n] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
+            sliding = True
+        elif p[2 * i + 1] != 0.0:
+            release[n] = -1.0 if p[2 * i + 1] > 0.0 else 1.0
+        else:
+            continue
+        candidates[n] = i
+        n += 1
+    return n if sliding else 0
 
 
 @jit
-def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign, others_free):
+def _modes_for(held_mask, candidates, release, n_candidates, u, states, mode, sign, others_free):
     """Mode of every contact when the candidates in `held_mask` stick and the others slide their
-    way (or, `others_free`, are free: MODE_FREE); the rest keep their state (stick, slide, open)."""
+    `release` way (or, `others_free`, are free: MODE_FREE); the rest keep their state (stick,
+    slide, open)."""
     for i in range(states.shape[0]):
         sign[i] = 0.0
         if states[i] == STATE_STICK:
@@ -338,7 +349,7 @@ def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign, other
             sign[i] = 0.0
         else:
             mode[i] = MODE_SLIDE
-            sign[i] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
+            sign[i] = release[c]
 
 
 @jit
@@ -376,8 +387,9 @@ def _without_gap_closing(q, closing, mode, q_held):
 
 @jit
 def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
-    """Hold what μs can hold: if another admissible solution of the step u = W p + q keeps more of
-    the contacts that started at rest sticking, overwrite p, u, states in place; return True then.
+    """Hold what μs can hold, and choose among the step's admissible solutions independently of
+    the order of the contacts: overwrite p, u, states in place with the chosen solution and return
+    True, or return False and leave the solver's answer.
 
     W (m×m), q (m,), p, u (m,) float64 with m = 2 na ordered (N, T) per contact; mu_s, mu_d,
     start_guess (na,) float64 — start_guess is the slip guess the step STARTED from (0 at rest,
@@ -385,15 +397,22 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     (the sign iteration's); closing (na,) float64: the part g/h of q_N that asks a persistent
     contact to close an open gap (0 if none) — a held mode may instead leave it open;
     states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
-    The largest held set wins (ties: the first in contact order); at most MAX_TRIALS tries.
-    With several candidates, each is first tried alone with the other candidates free (MODE_FREE:
-    touching, impulse in the μs cone, any slip) — a relaxation of every mode that holds it, and
-    monotone: a candidate that cannot be held so is in no held set, and is dropped. A collision
-    cascade (n candidates, none holdable) then costs n small LPs instead of 2ⁿ − 1.
+
+    Runs when a contact that started at rest slides. The candidates are the contacts that started
+    at rest and touch (`_resting_contacts`), sticking or sliding; a held set S is admissible when
+    some split sticks S and slides the other candidates (admissible_split). The largest admissible
+    S wins when it is the only one of its size; when several tie (a symmetric scene: the mirror
+    images of one mode) none of them is preferred: the search goes on below their intersection,
+    which the scene's symmetries map to itself. So the answer depends on the sets, not on the
+    order of the contacts (`held_set`). With several candidates, each is first tried alone with
+    the other candidates free (MODE_FREE: touching, impulse in the μs cone, any slip) — a
+    relaxation of every mode that holds it: a candidate that cannot be held so is in no held set,
+    and is dropped. At most MAX_TRIALS tries.
     """
     na = mu_s.shape[0]
     candidates = np.empty(na, dtype=np.int64)
-    n_c = _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates)
+    release = np.empty(na)
+    n_c = _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release)
     if n_c == 0:
         return False
     w_max = max(1e-300, np.max(np.abs(W)))
@@ -408,24 +427,63 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     if n_c > 1:  # pruning: each candidate alone, with the other candidates free
         kept = 0
         for c in range(n_c):
-            _modes_for(1 << c, candidates, n_c, u, states, mode, sign, True)
+            _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
             if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-                candidates[kept] = candidates[c]
+                candidates[kept], release[kept] = candidates[c], release[c]
                 kept += 1
+            elif states[candidates[c]] == STATE_STICK:  # held by the solver: the relaxation failed on
+                return False                             # round-off; keep the solver's answer
         n_c = min(kept, MAX_CANDIDATES)
+    held = held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
+                    velocity_tol, scale, p_new)
+    if held < 0 or held == _sticking_mask(candidates, n_c, states):
+        return False  # nothing admissible, or the solver's own mode (its velocities are the mode's)
+    _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
+    return True
+
+
+@jit
+def _sticking_mask(candidates, n_c, states):
+    """The candidates the solver's answer holds, as a bit mask."""
+    mask = 0
+    for c in range(n_c):
+        if states[candidates[c]] == STATE_STICK:
+            mask |= 1 << c
+    return mask
+
+
+@jit
+def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+             scale, p_new):
+    """The held set of prefer_sticking as a bit mask over the candidates (mode, sign and p_new
+    filled for it), or −1 when none is admissible or the trials run out. Largest first; a size
+    with one admissible set returns it; a size with several restricts the search to the subsets of
+    their intersection (strictly smaller), so a tie is never broken by contact order."""
+    allowed = (1 << n_c) - 1
     trials = 0
-    for size in range(n_c, 0, -1):
-        for held in range(1, 1 << n_c):
-            if _popcount(held) != size:
-                continue
-            if trials == MAX_TRIALS:
-                return False
-            trials += 1
-            _modes_for(held, candidates, n_c, u, states, mode, sign, False)
-            if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-                _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
-                return True
-    return False
+    p_found = np.empty_like(p_new)
+    while True:
+        found, n_found, common = -1, 0, allowed
+        for size in range(_popcount(allowed), -1, -1):
+            for held in range(allowed + 1):
+                if held & ~allowed or _popcount(held) != size:
+                    continue
+                if trials == MAX_TRIALS:
+                    return -1
+                trials += 1
+                _modes_for(held, candidates, release, n_c, u, states, mode, sign, False)
+                if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+                    found, n_found, common = held, n_found + 1, common & held
+                    p_found[:] = p_new
+            if n_found > 0:
+                break
+        if n_found == 0:
+            return -1
+        if n_found == 1:
+            _modes_for(found, candidates, release, n_c, u, states, mode, sign, False)
+            p_new[:] = p_found
+            return found
+        allowed = common
 
 
 @jit
