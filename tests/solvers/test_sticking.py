@@ -234,8 +234,9 @@ def test_candidates_no_split_can_hold_are_pruned_and_the_others_still_held(compi
 
 def _exhaustive_hold(W, q, mu_s, mu_d, p, u, states, tol):
     """The held set without pruning, written from the rule's statement: the candidates are the
-    touching contacts (all started at rest); every subset, largest first, sticks it and slides the
-    other candidates (their own slip direction, or against their friction); the largest admissible
+    touching contacts and the lifting ones (all started at rest); every subset, largest first,
+    sticks it and slides the other candidates (their own slip direction, or against their
+    friction) or lets them lift; the largest admissible
     set wins if it is the only one of its size, else the search goes on among the subsets of the
     tied sets' intersection. Returns the final set of sticking contacts, or None (nothing
     admissible, or the solver's own mode)."""
@@ -244,10 +245,13 @@ def _exhaustive_hold(W, q, mu_s, mu_d, p, u, states, tol):
     from nonsmooth_rod.solvers.sticking import MODE_OPEN, MODE_SLIDE, MODE_STICK, admissible_split
 
     na = len(mu_s)
-    cand = [i for i in range(na) if abs(u[2 * i]) <= tol and (abs(u[2 * i + 1]) > tol or p[2 * i + 1] != 0.0)]
-    if all(abs(u[2 * i + 1]) <= tol for i in cand):
+    lifting = [i for i in range(na) if u[2 * i] > tol and states[i] == STATE_OPEN]
+    cand = sorted(lifting + [i for i in range(na) if abs(u[2 * i]) <= tol
+                             and (abs(u[2 * i + 1]) > tol or p[2 * i + 1] != 0.0)])
+    if not lifting and all(abs(u[2 * i + 1]) <= tol for i in cand):
         return None
-    release = {i: np.sign(u[2 * i + 1]) if abs(u[2 * i + 1]) > tol else -np.sign(p[2 * i + 1]) for i in cand}
+    release = {i: 0.0 if i in lifting else np.sign(u[2 * i + 1]) if abs(u[2 * i + 1]) > tol else
+               -np.sign(p[2 * i + 1]) for i in cand}
     scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / np.max(np.abs(W)))
     allowed = set(cand)
     while True:
@@ -255,8 +259,8 @@ def _exhaustive_hold(W, q, mu_s, mu_d, p, u, states, tol):
             found = []
             for held in combinations(sorted(allowed), size):
                 mode = np.array([MODE_STICK if (i in held or (i not in cand and states[i] == STATE_STICK)) else
-                                 (MODE_OPEN if states[i] == STATE_OPEN and i not in cand else MODE_SLIDE)
-                                 for i in range(na)], dtype=np.int64)
+                                 (MODE_OPEN if states[i] == STATE_OPEN and (i not in cand or release[i] == 0.0)
+                                  else MODE_SLIDE) for i in range(na)], dtype=np.int64)
                 sign = np.array([0.0 if mode[i] != MODE_SLIDE else
                                  (release[i] if i in cand else np.sign(u[2 * i + 1])) for i in range(na)])
                 if admissible_split(W, q, mu_s, mu_d, mode, sign, tol, scale, np.zeros(2 * na)):

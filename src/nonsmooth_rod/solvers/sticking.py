@@ -31,6 +31,9 @@ MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
 # Touching, the impulse anywhere in the μs cone, any slip: sticking and sliding relaxed into one
 # mode (the pruning test of prefer_sticking).
 MODE_FREE = 3
+# Touching or open — p_N ≥ 0, u_N ≥ 0, the impulse in the μs cone, without complementarity: the
+# relaxation of an open candidate, which either separates or is held.
+MODE_LOOSE = 4
 MAX_CANDIDATES = 16  # contacts that survive the pruning considered for a held set (beyond: the first 16)
 MAX_TRIALS = 64  # feasibility problems per step at most
 SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driven LP
@@ -137,15 +140,15 @@ def simplex_max(c, G, h, x):
 
 @jit
 def _unknowns(mode, sign, mu_d):
-    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking (and free)
-    ones; a sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode (u_N = 0 of
-    closed contacts, u_T = 0 of sticking ones)."""
+    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking (and free,
+    loose) ones; a sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode
+    (u_N = 0 of closed contacts but loose ones, u_T = 0 of sticking ones)."""
     na = mode.shape[0]
     n_x, n_rows = 0, 0
     for i in range(na):
         if mode[i] != MODE_OPEN:
             n_x += 1 if mode[i] == MODE_SLIDE else 2
-            n_rows += 2 if mode[i] == MODE_STICK else 1
+            n_rows += 2 if mode[i] == MODE_STICK else (0 if mode[i] == MODE_LOOSE else 1)
     P = np.zeros((2 * na, n_x))
     rows = np.empty(n_rows, dtype=np.int64)
     k, r = 0, 0
@@ -153,8 +156,9 @@ def _unknowns(mode, sign, mu_d):
         if mode[i] == MODE_OPEN:
             continue
         P[2 * i, k] = 1.0
-        rows[r] = 2 * i
-        r += 1
+        if mode[i] != MODE_LOOSE:
+            rows[r] = 2 * i
+            r += 1
         if mode[i] == MODE_SLIDE:
             P[2 * i + 1, k] = -mu_d[i] * sign[i]
             k += 1
@@ -196,9 +200,9 @@ def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
     u0 = W @ p0 + q
     Wz = W @ Pz
     w_scale = max(1e-300, np.max(np.abs(W)))
-    G = np.zeros((3 * na, k))
-    h = np.zeros(3 * na)
-    weight = np.zeros(3 * na)
+    G = np.zeros((4 * na, k))
+    h = np.zeros(4 * na)
+    weight = np.zeros(4 * na)
     n = 0
     for i in range(na):
         if mode[i] == MODE_OPEN:  # velocities in impulse units: divided by max|W|
@@ -210,7 +214,11 @@ def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
         h[n] = p0[2 * i]
         weight[n] = 1.0
         n += 1
-        if mode[i] == MODE_STICK or mode[i] == MODE_FREE:
+        if mode[i] == MODE_LOOSE:  # u_N ≥ −tol/2 in place of u_N = 0 (the margin pushes it to the
+            G[n] = Wz[2 * i] / w_scale   # bound: half, so that round-off stays within the final check's)
+            h[n] = (u0[2 * i] + 0.5 * velocity_tol) / w_scale
+            n += 1
+        if mode[i] == MODE_STICK or mode[i] == MODE_FREE or mode[i] == MODE_LOOSE:
             for side in (-1.0, 1.0):
                 G[n] = mu_s[i] * Pz[2 * i] + side * Pz[2 * i + 1]
                 h[n] = mu_s[i] * p0[2 * i] + side * p0[2 * i + 1]
@@ -266,9 +274,9 @@ def _split_obeys_law(W, q, mode, sign, mu_s, p, u, velocity_tol, scale):
             if un < -velocity_tol:
                 return False
             continue
-        if pn < -p_tol or abs(un) > velocity_tol:
+        if pn < -p_tol or (un < -velocity_tol if mode[i] == MODE_LOOSE else abs(un) > velocity_tol):
             return False
-        if mode[i] == MODE_STICK or mode[i] == MODE_FREE:
+        if mode[i] == MODE_STICK or mode[i] == MODE_FREE or mode[i] == MODE_LOOSE:
             if (mode[i] == MODE_STICK and abs(ut) > velocity_tol) or abs(pt) > mu_s[i] * pn + p_tol:
                 return False
         elif sign[i] * ut < -velocity_tol:
@@ -302,34 +310,40 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
 
 @jit
 def _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release):
-    """Contacts that started the step at rest (guess 0) and touch at its end (u_N = 0, or u_N equal
-    to the gap-closing velocity), sliding (or touching with no impulse) or sticking: the step's choice among its admissible
-    solutions is a choice of which of them stick. `release` gets the slip sign each would slide
-    with when not held: its own slip direction, or for a sticking one the direction its friction
-    opposes (a sticking contact with no friction has no direction and is not a candidate).
-    Returns how many; 0 when none of them slides (the solver's answer holds them all)."""
-    n, sliding = 0, False
+    """Contacts that started the step at rest (guess 0) and either touch at its end (u_N = 0, or u_N
+    equal to the gap-closing velocity) or left it (open, u_N > 0): the step's choice among its
+    admissible solutions is a choice of which of them stick. `release` gets what each does when not
+    held: slide its own slip direction (±1), or for a sticking one the direction its friction
+    opposes, or separate (0: an open one). A sticking contact with no friction has no direction
+    and is not a candidate. Returns how many; 0 when all of them stick (the solver's answer holds
+    them all)."""
+    n, moving = 0, False
     for i in range(start_guess.shape[0]):
-        touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
-        if start_guess[i] != 0.0 or not touching:
+        if start_guess[i] != 0.0:
             continue
-        if abs(u[2 * i + 1]) > velocity_tol:
+        touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
+        if not touching and states[i] == STATE_OPEN:
+            release[n] = 0.0
+            moving = True
+        elif not touching:
+            continue
+        elif abs(u[2 * i + 1]) > velocity_tol:
             release[n] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
-            sliding = True
+            moving = True
         elif p[2 * i + 1] != 0.0:
             release[n] = -1.0 if p[2 * i + 1] > 0.0 else 1.0
         else:
             continue
         candidates[n] = i
         n += 1
-    return n if sliding else 0
+    return n if moving else 0
 
 
 @jit
 def _modes_for(held_mask, candidates, release, n_candidates, u, states, mode, sign, others_free):
     """Mode of every contact when the candidates in `held_mask` stick and the others slide their
-    `release` way (or, `others_free`, are free: MODE_FREE); the rest keep their state (stick,
-    slide, open)."""
+    `release` way or open (or, `others_free`, are free: MODE_FREE); the rest keep their state
+    (stick, slide, open)."""
     for i in range(states.shape[0]):
         sign[i] = 0.0
         if states[i] == STATE_STICK:
@@ -345,8 +359,10 @@ def _modes_for(held_mask, candidates, release, n_candidates, u, states, mode, si
             mode[i] = MODE_STICK
             sign[i] = 0.0
         elif others_free:
-            mode[i] = MODE_FREE
+            mode[i] = MODE_LOOSE if release[c] == 0.0 else MODE_FREE
             sign[i] = 0.0
+        elif release[c] == 0.0:
+            mode[i] = MODE_OPEN
         else:
             mode[i] = MODE_SLIDE
             sign[i] = release[c]
@@ -405,8 +421,8 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     images of one mode) none of them is preferred: the search goes on below their intersection,
     which the scene's symmetries map to itself. So the answer depends on the sets, not on the
     order of the contacts (`held_set`). With several candidates, each is first tried alone with
-    the other candidates free (MODE_FREE: touching, impulse in the μs cone, any slip) — a
-    relaxation of every mode that holds it: a candidate that cannot be held so is in no held set,
+    the other candidates free (MODE_FREE: touching, impulse in the μs cone, any slip; MODE_LOOSE
+    for an open one: touching or not) — a relaxation of every mode that holds it: a candidate that cannot be held so is in no held set,
     and is dropped. At most MAX_TRIALS tries.
     """
     na = mu_s.shape[0]
@@ -611,4 +627,4 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
 
 __all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
            "scatter_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK", "STATE_SLIP_PLUS",
-           "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE"]
+           "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE", "MODE_LOOSE"]
