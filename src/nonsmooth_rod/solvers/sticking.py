@@ -1,4 +1,4 @@
-"""Sticking preference of the Moreau–Jean step: a contact slides only if no admissible split holds it.
+"""Sticking preference of the Moreau–Jean step: a contact at rest slides only if no admissible split holds it.
 
 Two or more contacts on one body make the step statically indeterminate: the Delassus matrix W is
 singular, the end-of-step velocities of a mode (which contacts stick, which slide which way) are
@@ -6,13 +6,16 @@ unique, but the impulses are not — any split p + Z z with Z spanning the null 
 mode's equations gives the same motion. An LCP solver returns one vertex of that set, and with
 it possibly a sliding solution although another admissible split would keep the contact at rest.
 
-`prefer_sticking` runs after the two-coefficient sign iteration has a consistent solution. For
-the contacts that started the step at rest (start guess 0), touch (u_N = 0) and slide, it asks the
+`prefer_sticking` runs after the two-coefficient sign iteration has a consistent solution in
+which a contact that started the step at rest (start guess 0) slides or lifts off. For the
+contacts that started at rest and touch (u_N = 0), sticking or sliding, or lifted off, it asks the
 event-driven integrator's question at impulse level (`model.dynamics._most_admissible_split`):
-is there a split of the step's impulses that keeps them sticking, every other closed contact in
-its state (sticking ones inside the μs cone, sliding ones on the μd line with their slip
-direction kept), open contacts open, and normal complementarity everywhere? The largest such
-set of held contacts wins; the split chosen is the one deepest inside every cone (maximal
+is there a split of the step's impulses that keeps a set of them sticking, the others released
+(sliding their way, or open), every other closed contact in its state (sticking ones inside the
+μs cone, sliding ones on the μd line with their slip direction kept), open contacts open, and
+normal complementarity everywhere? The largest such set wins if it is the only one of its size;
+tied sets (mirror images in a symmetric scene) are not broken by contact order: the search goes
+on below their intersection. The split chosen is the one deepest inside every cone (maximal
 smallest margin min(p_N, μs p_N − |p_T|)), found by a small dense simplex. See docs/friction.md.
 `prefer_sticking_by_group` runs it on each group of coupled contacts alone (the step's problem is
 block-diagonal over them).
@@ -414,15 +417,16 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     contact to close an open gap (0 if none) — a held mode may instead leave it open;
     states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
 
-    Runs when a contact that started at rest slides. The candidates are the contacts that started
-    at rest and touch (`_resting_contacts`), sticking or sliding; a held set S is admissible when
-    some split sticks S and slides the other candidates (admissible_split). The largest admissible
-    S wins when it is the only one of its size; when several tie (a symmetric scene: the mirror
-    images of one mode) none of them is preferred: the search goes on below their intersection,
-    which the scene's symmetries map to itself. So the answer depends on the sets, not on the
-    order of the contacts (`held_set`). With several candidates, each is first tried alone with
-    the other candidates free (MODE_FREE: touching, impulse in the μs cone, any slip; MODE_LOOSE
-    for an open one: touching or not) — a relaxation of every mode that holds it: a candidate that cannot be held so is in no held set,
+    Runs when a contact that started at rest slides or lifts off. The candidates are the contacts
+    that started at rest and touch, sticking or sliding, or lifted off (`_resting_contacts`); a
+    held set S is admissible when some split sticks S and releases the other candidates
+    (admissible_split). The largest admissible S wins when it is the only one of its size; when
+    several tie (a symmetric scene: the mirror images of one mode) none of them is preferred: the
+    search goes on below their intersection, which the scene's symmetries map to itself. So the
+    answer depends on the sets, not on the order of the contacts (`held_set`). With several
+    candidates, each is first tried alone with the other candidates free (MODE_FREE: touching,
+    impulse in the μs cone, any slip; MODE_LOOSE for a lifting one: touching or not) — a
+    relaxation of every mode that holds it: a candidate that cannot be held so is in no held set,
     and is dropped. At most MAX_TRIALS tries.
     """
     na = mu_s.shape[0]
