@@ -444,15 +444,19 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     p_new = np.zeros(2 * na)
     q_held = np.empty(2 * na)
     n_c = min(n_c, 62)  # a bit mask of the candidates
-    if n_c > 1:  # pruning: each candidate alone, with the other candidates free
-        kept = 0
+    # every candidate held: if admissible, the one largest set (the common step of a body at rest)
+    _modes_for((1 << n_c) - 1, candidates, release, n_c, u, states, mode, sign, False)
+    if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+        _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
+        return True
+    if n_c > 1:  # pruning: each candidate alone, with the other candidates free (one the solver
+        kept = 0  # holds needs no test: its answer is a split of the relaxation)
         for c in range(n_c):
             _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
-            if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+            if states[candidates[c]] == STATE_STICK or _admissible_either(
+                    W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
                 candidates[kept], release[kept] = candidates[c], release[c]
                 kept += 1
-            elif states[candidates[c]] == STATE_STICK:  # held by the solver: the relaxation failed on
-                return False                             # round-off; keep the solver's answer
         n_c = min(kept, MAX_CANDIDATES)
     held = held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
                     velocity_tol, scale, p_new)
