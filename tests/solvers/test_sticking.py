@@ -203,7 +203,8 @@ def test_each_group_is_held_alone_as_if_it_were_the_whole_step(compiled):
     p, u, states = _free_fall(q)
     tol = 1e-9 * np.max(np.abs(q))
     empty = np.zeros(0, dtype=np.int64)
-    assert run(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u, states, 64)
+    assert run(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u, states, 64,
+               np.zeros(0))
     p1, u1, states1 = _free_fall(q1)
     assert prefer_sticking(W1, q1, mu_s[:2], mu_d[:2], np.zeros(2), tol, np.zeros(2), p1, u1, states1)
     # the holdable rod gets exactly its own held split; the other keeps falling, untouched
@@ -213,7 +214,7 @@ def test_each_group_is_held_alone_as_if_it_were_the_whole_step(compiled):
     # a group larger than max_group keeps the solver's answer
     p, u, states = _free_fall(q)
     assert not run(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, np.zeros(4), tol, np.zeros(4), p, u,
-                   states, 1)
+                   states, 1, np.zeros(0))
     assert np.all(p == 0.0)
 
 
@@ -332,3 +333,25 @@ def test_pruned_search_holds_the_same_contacts_as_the_exhaustive_one(case):
     assert held == (expected is not None)
     if held:
         assert sorted(np.flatnonzero(states == STATE_STICK)) == expected
+
+
+def test_a_previous_split_that_still_holds_is_reused_and_one_that_does_not_is_not():
+    """A body held at rest meets the same problem every step: the previous step's split, which
+    holds it to round-off, is the answer (no LP); a split that leaves it moving is not."""
+    from nonsmooth_rod.solvers.sticking import prefer_sticking_from
+
+    W, q = _step_problem(WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5))
+    mu_s, mu_d, tol = np.full(2, 0.7), np.full(2, 0.5), 1e-9 * np.max(np.abs(q))
+    p, u, states = _free_fall(q)
+    assert prefer_sticking(W, q, mu_s, mu_d, np.zeros(2), tol, np.zeros(2), p, u, states)
+    held = p.copy()
+    squeeze = np.linalg.svd(W)[2][-1]  # W's null space: impulses that move nothing
+    previous = held + 0.01 * np.max(np.abs(held)) * squeeze  # still held, not the deepest split
+    assert np.max(np.abs(W @ previous + q)) <= 1e-12 * np.max(np.abs(q))
+    p, u, states = _free_fall(q)
+    assert prefer_sticking_from(W, q, mu_s, mu_d, np.zeros(2), tol, np.zeros(2), p, u, states, previous)
+    np.testing.assert_array_equal(p, previous)
+    moving = 0.5 * held  # half the impulse: the rod would fall
+    p, u, states = _free_fall(q)
+    assert prefer_sticking_from(W, q, mu_s, mu_d, np.zeros(2), tol, np.zeros(2), p, u, states, moving)
+    np.testing.assert_array_equal(p, held)  # the LP's split again

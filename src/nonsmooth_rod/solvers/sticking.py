@@ -43,6 +43,9 @@ SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driv
 PIVOT_TOL = 1e-11
 RANK_TOL = 1e-10  # singular values below RANK_TOL × the largest span the indeterminate splits
 MARGIN_TOL = 1e-9  # a cone margin above −MARGIN_TOL × the impulse scale is admissible
+# The previous step's split is reused when it leaves velocities below REUSE_TOL × the slip
+# tolerance (round-off: 1e-12 |q|), so that a held body does not creep at the tolerance.
+REUSE_TOL = 1e-3
 
 
 @jit
@@ -312,20 +315,20 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
 
 
 @jit
-def _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release):
+def _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release, moving_only):
     """Contacts that started the step at rest (guess 0) and either touch at its end (u_N = 0, or u_N
     equal to the gap-closing velocity) or left it (open, u_N > 0): the step's choice among its
     admissible solutions is a choice of which of them stick. `release` gets what each does when not
     held: slide its own slip direction (±1), or for a sticking one the direction its friction
     opposes, or separate (0: an open one). A sticking contact with no friction has no direction
-    and is not a candidate. Returns how many; 0 when all of them stick (the solver's answer holds
-    them all)."""
+    and is not a candidate; `moving_only`: only the sliding ones (the search of a large group).
+    Returns how many; 0 when all of them stick (the solver's answer holds them all)."""
     n, moving = 0, False
     for i in range(start_guess.shape[0]):
         if start_guess[i] != 0.0:
             continue
         touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
-        if not touching and states[i] == STATE_OPEN:
+        if not touching and states[i] == STATE_OPEN and not moving_only:
             release[n] = 0.0
             moving = True
         elif not touching:
@@ -333,7 +336,7 @@ def _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidat
         elif abs(u[2 * i + 1]) > velocity_tol:
             release[n] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
             moving = True
-        elif p[2 * i + 1] != 0.0:
+        elif p[2 * i + 1] != 0.0 and not moving_only:
             release[n] = -1.0 if p[2 * i + 1] > 0.0 else 1.0
         else:
             continue
@@ -406,6 +409,12 @@ def _without_gap_closing(q, closing, mode, q_held):
 
 @jit
 def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
+    """prefer_sticking_from without a previous split."""
+    return prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states, np.zeros(0))
+
+
+@jit
+def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states, p_start):
     """Hold what μs can hold, and choose among the step's admissible solutions independently of
     the order of the contacts: overwrite p, u, states in place with the chosen solution and return
     True, or return False and leave the solver's answer.
@@ -415,24 +424,26 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     ±1 sliding), not the converged one; velocity_tol: the velocity below which a slip is zero
     (the sign iteration's); closing (na,) float64: the part g/h of q_N that asks a persistent
     contact to close an open gap (0 if none) — a held mode may instead leave it open;
-    states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
+    states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−; p_start (m,) or empty: the previous
+    step's impulses — when they still hold every candidate to round-off (a body held at rest:
+    the same problem again) they are the answer, without an LP.
 
-    Runs when a contact that started at rest slides or lifts off. The candidates are the contacts
-    that started at rest and touch, sticking or sliding, or lifted off (`_resting_contacts`); a
-    held set S is admissible when some split sticks S and releases the other candidates
-    (admissible_split). The largest admissible S wins when it is the only one of its size; when
-    several tie (a symmetric scene: the mirror images of one mode) none of them is preferred: the
-    search goes on below their intersection, which the scene's symmetries map to itself. So the
-    answer depends on the sets, not on the order of the contacts (`held_set`). With several
-    candidates, each is first tried alone with the other candidates free (MODE_FREE: touching,
-    impulse in the μs cone, any slip; MODE_LOOSE for a lifting one: touching or not) — a
-    relaxation of every mode that holds it: a candidate that cannot be held so is in no held set,
-    and is dropped. At most MAX_TRIALS tries.
+    Runs when a contact that started at rest slides or lifts off. Candidates: the contacts that
+    started at rest and touch, or lifted off (`_resting_contacts`); S is admissible when a split
+    sticks S and releases the others (admissible_split). All held first (`_all_held`); else each
+    candidate is tried held with the others free (MODE_FREE, MODE_LOOSE: a relaxation of every
+    mode that holds it; one that fails is in no held set and is dropped); then `held_set`: the
+    largest admissible S if it is the only one of its size, else the search goes on below the tied
+    sets' intersection — never contact order. At most MAX_TRIALS tries. Beyond MAX_CANDIDATES
+    candidates (a large pile) only the sliding ones are searched (order-dependent, but no LPs on
+    the whole group in every step where a contact lifts).
     """
     na = mu_s.shape[0]
     candidates = np.empty(na, dtype=np.int64)
     release = np.empty(na)
-    n_c = _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release)
+    n_c = _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release, False)
+    if n_c > MAX_CANDIDATES:  # too many for the whole choice: only hold what slides (order-dependent)
+        n_c = _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release, True)
     if n_c == 0:
         return False
     w_max = max(1e-300, np.max(np.abs(W)))
@@ -444,9 +455,8 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     p_new = np.zeros(2 * na)
     q_held = np.empty(2 * na)
     n_c = min(n_c, 62)  # a bit mask of the candidates
-    # every candidate held: if admissible, the one largest set (the common step of a body at rest)
-    _modes_for((1 << n_c) - 1, candidates, release, n_c, u, states, mode, sign, False)
-    if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+    if _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+                 scale, p_start, p_new):
         _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
         return True
     if n_c > 1:  # pruning: each candidate alone, with the other candidates free (one the solver
@@ -464,6 +474,20 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
         return False  # nothing admissible, or the solver's own mode (its velocities are the mode's)
     _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
     return True
+
+
+@jit
+def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+              scale, p_start, p_new):
+    """Is every candidate held admissible (then the one largest set: the common step of a body at
+    rest)? The previous step's split p_start, when it still holds them to round-off, is the answer
+    without an LP. Fills mode, sign and p_new."""
+    _modes_for((1 << n_c) - 1, candidates, release, n_c, u, states, mode, sign, False)
+    if p_start.shape[0] == p_new.shape[0] and _split_obeys_law(W, q, mode, sign, mu_s, p_start, W @ p_start + q,
+                                                               REUSE_TOL * velocity_tol, scale):
+        p_new[:] = p_start
+        return True
+    return _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
 
 
 @jit
@@ -601,19 +625,20 @@ def scatter_contacts(members, p_group, u_group, states_group, p, u, states):
 
 @jit
 def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
-                             states, max_group):
+                             states, max_group, p_start):
     """prefer_sticking on each group of coupled contacts alone (coupled_components). The step's
     problem is block-diagonal over the groups, so the largest held set of the whole step is the
     union of each group's, and each search is over its own candidates: 2^n_g small dense LPs
     rather than 2^(Σ n_g) large ones. Only groups with a contact that started at rest and does
     not stick (start_guess 0) are searched, and only those of at most `max_group` contacts.
-    W is dense, or empty with its block-sparse form. True when any p, u, states changed."""
+    W is dense, or empty with its block-sparse form; p_start: the previous step's impulses, or
+    empty. True when any p, u, states changed."""
     na = mu_s.shape[0]
     label = np.empty(na, dtype=np.int64)
     groups = coupled_components(indptr, indices, W, label)
     if groups == 1 and W.shape[0] > 0:  # one dense group (the common case): nothing to gather
-        return na <= max_group and prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
-                                                   states)
+        return na <= max_group and prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p,
+                                                        u, states, p_start)
     changed = False
     for g in range(groups):
         members = np.flatnonzero(label == g)
@@ -624,15 +649,16 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
             continue
         pg, ug = gather_contacts(members, p, True), gather_contacts(members, u, True)
         states_g = gather_contacts(members, states, False)
-        if prefer_sticking(group_matrix(members, W, indptr, indices, blocks), gather_contacts(members, q, True),
-                           gather_contacts(members, mu_s, False), gather_contacts(members, mu_d, False),
-                           gather_contacts(members, start_guess, False), velocity_tol,
-                           gather_contacts(members, closing, False), pg, ug, states_g):
+        start_g = gather_contacts(members, p_start, True) if p_start.shape[0] == p.shape[0] else np.zeros(0)
+        if prefer_sticking_from(group_matrix(members, W, indptr, indices, blocks), gather_contacts(members, q, True),
+                                gather_contacts(members, mu_s, False), gather_contacts(members, mu_d, False),
+                                gather_contacts(members, start_guess, False), velocity_tol,
+                                gather_contacts(members, closing, False), pg, ug, states_g, start_g):
             scatter_contacts(members, pg, ug, states_g, p, u, states)
             changed = True
     return changed
 
 
-__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
+__all__ = ["prefer_sticking", "prefer_sticking_from", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
            "scatter_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK", "STATE_SLIP_PLUS",
            "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE", "MODE_LOOSE"]
