@@ -11,7 +11,8 @@ Per step of size h, from (q_k, v_k):
 
 Impacts need no special case: a contact that closes within a step gets the impulse that makes
 u_N⁺ + e u_N⁻ ≥ 0 ⊥ p_N ≥ 0 hold at the end of the step. The scheme is first order on
-nonsmooth solutions and, with e = 0 and θ = ½, dissipative (energy never grows).
+nonsmooth solutions; with e = 0 and θ = ½ a step gains at most the work ½ pᵀH(q_k)v_k of its
+impulses on the start velocity, O(h²) for a persistent contact (docs/friction.md, "Energy").
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Sticking preference of the Moreau–Jean step: a contact slides only if no admissible split holds it.
+"""Sticking preference of the Moreau–Jean step: a contact at rest slides only if no admissible split holds it.
 
 Two or more contacts on one body make the step statically indeterminate: the Delassus matrix W is
 singular, the end-of-step velocities of a mode (which contacts stick, which slide which way) are
@@ -6,13 +6,16 @@ unique, but the impulses are not — any split p + Z z with Z spanning the null 
 mode's equations gives the same motion. An LCP solver returns one vertex of that set, and with
 it possibly a sliding solution although another admissible split would keep the contact at rest.
 
-`prefer_sticking` runs after the two-coefficient sign iteration has a consistent solution. For
-the contacts that started the step at rest (start guess 0), touch (u_N = 0) and slide, it asks the
+`prefer_sticking` runs after the two-coefficient sign iteration has a consistent solution in
+which a contact that started the step at rest (start guess 0) slides or lifts off. For the
+contacts that started at rest and touch (u_N = 0), sticking or sliding, or lifted off, it asks the
 event-driven integrator's question at impulse level (`model.dynamics._most_admissible_split`):
-is there a split of the step's impulses that keeps them sticking, every other closed contact in
-its state (sticking ones inside the μs cone, sliding ones on the μd line with their slip
-direction kept), open contacts open, and normal complementarity everywhere? The largest such
-set of held contacts wins; the split chosen is the one deepest inside every cone (maximal
+is there a split of the step's impulses that keeps a set of them sticking, the others released
+(sliding their way, or open), every other closed contact in its state (sticking ones inside the
+μs cone, sliding ones on the μd line with their slip direction kept), open contacts open, and
+normal complementarity everywhere? The largest such set wins if it is the only one of its size;
+tied sets (mirror images in a symmetric scene) are not broken by contact order: the search goes
+on below their intersection. The split chosen is the one deepest inside every cone (maximal
 smallest margin min(p_N, μs p_N − |p_T|)), found by a small dense simplex. See docs/friction.md.
 `prefer_sticking_by_group` runs it on each group of coupled contacts alone (the step's problem is
 block-diagonal over them).
@@ -31,12 +34,18 @@ MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
 # Touching, the impulse anywhere in the μs cone, any slip: sticking and sliding relaxed into one
 # mode (the pruning test of prefer_sticking).
 MODE_FREE = 3
+# Touching or open — p_N ≥ 0, u_N ≥ 0, the impulse in the μs cone, without complementarity: the
+# relaxation of an open candidate, which either separates or is held.
+MODE_LOOSE = 4
 MAX_CANDIDATES = 16  # contacts that survive the pruning considered for a held set (beyond: the first 16)
 MAX_TRIALS = 64  # feasibility problems per step at most
 SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driven LP
 PIVOT_TOL = 1e-11
 RANK_TOL = 1e-10  # singular values below RANK_TOL × the largest span the indeterminate splits
 MARGIN_TOL = 1e-9  # a cone margin above −MARGIN_TOL × the impulse scale is admissible
+# The previous step's split is reused when it leaves velocities below REUSE_TOL × the slip
+# tolerance (round-off: 1e-12 |q|), so that a held body does not creep at the tolerance.
+REUSE_TOL = 1e-3
 
 
 @jit
@@ -137,15 +146,15 @@ def simplex_max(c, G, h, x):
 
 @jit
 def _unknowns(mode, sign, mu_d):
-    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking (and free)
-    ones; a sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode (u_N = 0 of
-    closed contacts, u_T = 0 of sticking ones)."""
+    """P with p = P x: x holds p_N of every closed contact and p_T of the sticking (and free,
+    loose) ones; a sliding contact's p_T is −μd s p_N. Also the equality rows E of the mode
+    (u_N = 0 of closed contacts but loose ones, u_T = 0 of sticking ones)."""
     na = mode.shape[0]
     n_x, n_rows = 0, 0
     for i in range(na):
         if mode[i] != MODE_OPEN:
             n_x += 1 if mode[i] == MODE_SLIDE else 2
-            n_rows += 2 if mode[i] == MODE_STICK else 1
+            n_rows += 2 if mode[i] == MODE_STICK else (0 if mode[i] == MODE_LOOSE else 1)
     P = np.zeros((2 * na, n_x))
     rows = np.empty(n_rows, dtype=np.int64)
     k, r = 0, 0
@@ -153,8 +162,9 @@ def _unknowns(mode, sign, mu_d):
         if mode[i] == MODE_OPEN:
             continue
         P[2 * i, k] = 1.0
-        rows[r] = 2 * i
-        r += 1
+        if mode[i] != MODE_LOOSE:
+            rows[r] = 2 * i
+            r += 1
         if mode[i] == MODE_SLIDE:
             P[2 * i + 1, k] = -mu_d[i] * sign[i]
             k += 1
@@ -196,9 +206,9 @@ def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
     u0 = W @ p0 + q
     Wz = W @ Pz
     w_scale = max(1e-300, np.max(np.abs(W)))
-    G = np.zeros((3 * na, k))
-    h = np.zeros(3 * na)
-    weight = np.zeros(3 * na)
+    G = np.zeros((4 * na, k))
+    h = np.zeros(4 * na)
+    weight = np.zeros(4 * na)
     n = 0
     for i in range(na):
         if mode[i] == MODE_OPEN:  # velocities in impulse units: divided by max|W|
@@ -210,7 +220,11 @@ def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
         h[n] = p0[2 * i]
         weight[n] = 1.0
         n += 1
-        if mode[i] == MODE_STICK or mode[i] == MODE_FREE:
+        if mode[i] == MODE_LOOSE:  # u_N ≥ −tol/2 in place of u_N = 0 (the margin pushes it to the
+            G[n] = Wz[2 * i] / w_scale   # bound: half, so that round-off stays within the final check's)
+            h[n] = (u0[2 * i] + 0.5 * velocity_tol) / w_scale
+            n += 1
+        if mode[i] == MODE_STICK or mode[i] == MODE_FREE or mode[i] == MODE_LOOSE:
             for side in (-1.0, 1.0):
                 G[n] = mu_s[i] * Pz[2 * i] + side * Pz[2 * i + 1]
                 h[n] = mu_s[i] * p0[2 * i] + side * p0[2 * i + 1]
@@ -266,9 +280,9 @@ def _split_obeys_law(W, q, mode, sign, mu_s, p, u, velocity_tol, scale):
             if un < -velocity_tol:
                 return False
             continue
-        if pn < -p_tol or abs(un) > velocity_tol:
+        if pn < -p_tol or (un < -velocity_tol if mode[i] == MODE_LOOSE else abs(un) > velocity_tol):
             return False
-        if mode[i] == MODE_STICK or mode[i] == MODE_FREE:
+        if mode[i] == MODE_STICK or mode[i] == MODE_FREE or mode[i] == MODE_LOOSE:
             if (mode[i] == MODE_STICK and abs(ut) > velocity_tol) or abs(pt) > mu_s[i] * pn + p_tol:
                 return False
         elif sign[i] * ut < -velocity_tol:
@@ -301,24 +315,41 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
 
 
 @jit
-def _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates):
-    """Contacts that started the step at rest (guess 0), touch at its end (u_N = 0, or u_N equal to
-    the gap-closing velocity) and slide: they must be held if any admissible split can hold them.
-    Returns how many."""
-    n = 0
+def _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release, moving_only):
+    """Contacts that started the step at rest (guess 0) and either touch at its end (u_N = 0, or u_N
+    equal to the gap-closing velocity) or left it (open, u_N > 0): the step's choice among its
+    admissible solutions is a choice of which of them stick. `release` gets what each does when not
+    held: slide its own slip direction (±1), or for a sticking one the direction its friction
+    opposes, or separate (0: an open one). A sticking contact with no friction has no direction
+    and is not a candidate; `moving_only`: only the sliding ones (the search of a large group).
+    Returns how many; 0 when all of them stick (the solver's answer holds them all)."""
+    n, moving = 0, False
     for i in range(start_guess.shape[0]):
+        if start_guess[i] != 0.0:
+            continue
         touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
-        if states[i] != STATE_STICK and start_guess[i] == 0.0 and touching \
-                and abs(u[2 * i + 1]) > velocity_tol:
-            candidates[n] = i
-            n += 1
-    return n
+        if not touching and states[i] == STATE_OPEN and not moving_only:
+            release[n] = 0.0
+            moving = True
+        elif not touching:
+            continue
+        elif abs(u[2 * i + 1]) > velocity_tol:
+            release[n] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
+            moving = True
+        elif p[2 * i + 1] != 0.0 and not moving_only:
+            release[n] = -1.0 if p[2 * i + 1] > 0.0 else 1.0
+        else:
+            continue
+        candidates[n] = i
+        n += 1
+    return n if moving else 0
 
 
 @jit
-def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign, others_free):
+def _modes_for(held_mask, candidates, release, n_candidates, u, states, mode, sign, others_free):
     """Mode of every contact when the candidates in `held_mask` stick and the others slide their
-    way (or, `others_free`, are free: MODE_FREE); the rest keep their state (stick, slide, open)."""
+    `release` way or open (or, `others_free`, are free: MODE_FREE); the rest keep their state
+    (stick, slide, open)."""
     for i in range(states.shape[0]):
         sign[i] = 0.0
         if states[i] == STATE_STICK:
@@ -334,11 +365,13 @@ def _modes_for(held_mask, candidates, n_candidates, u, states, mode, sign, other
             mode[i] = MODE_STICK
             sign[i] = 0.0
         elif others_free:
-            mode[i] = MODE_FREE
+            mode[i] = MODE_LOOSE if release[c] == 0.0 else MODE_FREE
             sign[i] = 0.0
+        elif release[c] == 0.0:
+            mode[i] = MODE_OPEN
         else:
             mode[i] = MODE_SLIDE
-            sign[i] = 1.0 if u[2 * i + 1] > 0.0 else -1.0
+            sign[i] = release[c]
 
 
 @jit
@@ -376,24 +409,41 @@ def _without_gap_closing(q, closing, mode, q_held):
 
 @jit
 def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
-    """Hold what μs can hold: if another admissible solution of the step u = W p + q keeps more of
-    the contacts that started at rest sticking, overwrite p, u, states in place; return True then.
+    """prefer_sticking_from without a previous split."""
+    return prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states, np.zeros(0))
+
+
+@jit
+def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states, p_start):
+    """Hold what μs can hold, and choose among the step's admissible solutions independently of
+    the order of the contacts: overwrite p, u, states in place with the chosen solution and return
+    True, or return False and leave the solver's answer.
 
     W (m×m), q (m,), p, u (m,) float64 with m = 2 na ordered (N, T) per contact; mu_s, mu_d,
     start_guess (na,) float64 — start_guess is the slip guess the step STARTED from (0 at rest,
     ±1 sliding), not the converged one; velocity_tol: the velocity below which a slip is zero
     (the sign iteration's); closing (na,) float64: the part g/h of q_N that asks a persistent
     contact to close an open gap (0 if none) — a held mode may instead leave it open;
-    states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−.
-    The largest held set wins (ties: the first in contact order); at most MAX_TRIALS tries.
-    With several candidates, each is first tried alone with the other candidates free (MODE_FREE:
-    touching, impulse in the μs cone, any slip) — a relaxation of every mode that holds it, and
-    monotone: a candidate that cannot be held so is in no held set, and is dropped. A collision
-    cascade (n candidates, none holdable) then costs n small LPs instead of 2ⁿ − 1.
+    states (na,) int64: 0 open, 1 stick, 2 slip+, 3 slip−; p_start (m,) or empty: the previous
+    step's impulses — when they still hold every candidate to round-off (a body held at rest:
+    the same problem again) they are the answer, without an LP.
+
+    Runs when a contact that started at rest slides or lifts off. Candidates: the contacts that
+    started at rest and touch, or lifted off (`_resting_contacts`); S is admissible when a split
+    sticks S and releases the others (admissible_split). All held first (`_all_held`); else each
+    candidate is tried held with the others free (MODE_FREE, MODE_LOOSE: a relaxation of every
+    mode that holds it; one that fails is in no held set and is dropped); then `held_set`: the
+    largest admissible S if it is the only one of its size, else the search goes on below the tied
+    sets' intersection — never contact order. At most MAX_TRIALS tries. Beyond MAX_CANDIDATES
+    candidates (a large pile) only the sliding ones are searched (order-dependent, but no LPs on
+    the whole group in every step where a contact lifts).
     """
     na = mu_s.shape[0]
     candidates = np.empty(na, dtype=np.int64)
-    n_c = _sliding_from_rest(start_guess, u, closing, states, velocity_tol, candidates)
+    release = np.empty(na)
+    n_c = _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release, False)
+    if n_c > MAX_CANDIDATES:  # too many for the whole choice: only hold what slides (order-dependent)
+        n_c = _resting_contacts(start_guess, p, u, closing, states, velocity_tol, candidates, release, True)
     if n_c == 0:
         return False
     w_max = max(1e-300, np.max(np.abs(W)))
@@ -405,27 +455,83 @@ def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, 
     p_new = np.zeros(2 * na)
     q_held = np.empty(2 * na)
     n_c = min(n_c, 62)  # a bit mask of the candidates
-    if n_c > 1:  # pruning: each candidate alone, with the other candidates free
-        kept = 0
+    if _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+                 scale, p_start, p_new):
+        _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
+        return True
+    if n_c > 1:  # pruning: each candidate alone, with the other candidates free (one the solver
+        kept = 0  # holds needs no test: its answer is a split of the relaxation)
         for c in range(n_c):
-            _modes_for(1 << c, candidates, n_c, u, states, mode, sign, True)
-            if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-                candidates[kept] = candidates[c]
+            _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
+            if states[candidates[c]] == STATE_STICK or _admissible_either(
+                    W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+                candidates[kept], release[kept] = candidates[c], release[c]
                 kept += 1
         n_c = min(kept, MAX_CANDIDATES)
+    held = held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
+                    velocity_tol, scale, p_new)
+    if held < 0 or held == _sticking_mask(candidates, n_c, states):
+        return False  # nothing admissible, or the solver's own mode (its velocities are the mode's)
+    _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
+    return True
+
+
+@jit
+def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+              scale, p_start, p_new):
+    """Is every candidate held admissible (then the one largest set: the common step of a body at
+    rest)? The previous step's split p_start, when it still holds them to round-off, is the answer
+    without an LP. Fills mode, sign and p_new."""
+    _modes_for((1 << n_c) - 1, candidates, release, n_c, u, states, mode, sign, False)
+    if p_start.shape[0] == p_new.shape[0] and _split_obeys_law(W, q, mode, sign, mu_s, p_start, W @ p_start + q,
+                                                               REUSE_TOL * velocity_tol, scale):
+        p_new[:] = p_start
+        return True
+    return _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+
+
+@jit
+def _sticking_mask(candidates, n_c, states):
+    """The candidates the solver's answer holds, as a bit mask."""
+    mask = 0
+    for c in range(n_c):
+        if states[candidates[c]] == STATE_STICK:
+            mask |= 1 << c
+    return mask
+
+
+@jit
+def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+             scale, p_new):
+    """The held set of prefer_sticking as a bit mask over the candidates (mode, sign and p_new
+    filled for it), or −1 when none is admissible or the trials run out. Largest first; a size
+    with one admissible set returns it; a size with several restricts the search to the subsets of
+    their intersection (strictly smaller), so a tie is never broken by contact order."""
+    allowed = (1 << n_c) - 1
     trials = 0
-    for size in range(n_c, 0, -1):
-        for held in range(1, 1 << n_c):
-            if _popcount(held) != size:
-                continue
-            if trials == MAX_TRIALS:
-                return False
-            trials += 1
-            _modes_for(held, candidates, n_c, u, states, mode, sign, False)
-            if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-                _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
-                return True
-    return False
+    p_found = np.empty_like(p_new)
+    while True:
+        found, n_found, common = -1, 0, allowed
+        for size in range(_popcount(allowed), -1, -1):
+            for held in range(allowed + 1):
+                if held & ~allowed or _popcount(held) != size:
+                    continue
+                if trials == MAX_TRIALS:
+                    return -1
+                trials += 1
+                _modes_for(held, candidates, release, n_c, u, states, mode, sign, False)
+                if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+                    found, n_found, common = held, n_found + 1, common & held
+                    p_found[:] = p_new
+            if n_found > 0:
+                break
+        if n_found == 0:
+            return -1
+        if n_found == 1:
+            _modes_for(found, candidates, release, n_c, u, states, mode, sign, False)
+            p_new[:] = p_found
+            return found
+        allowed = common
 
 
 @jit
@@ -519,19 +625,20 @@ def scatter_contacts(members, p_group, u_group, states_group, p, u, states):
 
 @jit
 def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
-                             states, max_group):
+                             states, max_group, p_start):
     """prefer_sticking on each group of coupled contacts alone (coupled_components). The step's
     problem is block-diagonal over the groups, so the largest held set of the whole step is the
     union of each group's, and each search is over its own candidates: 2^n_g small dense LPs
     rather than 2^(Σ n_g) large ones. Only groups with a contact that started at rest and does
     not stick (start_guess 0) are searched, and only those of at most `max_group` contacts.
-    W is dense, or empty with its block-sparse form. True when any p, u, states changed."""
+    W is dense, or empty with its block-sparse form; p_start: the previous step's impulses, or
+    empty. True when any p, u, states changed."""
     na = mu_s.shape[0]
     label = np.empty(na, dtype=np.int64)
     groups = coupled_components(indptr, indices, W, label)
     if groups == 1 and W.shape[0] > 0:  # one dense group (the common case): nothing to gather
-        return na <= max_group and prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
-                                                   states)
+        return na <= max_group and prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p,
+                                                        u, states, p_start)
     changed = False
     for g in range(groups):
         members = np.flatnonzero(label == g)
@@ -542,15 +649,16 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
             continue
         pg, ug = gather_contacts(members, p, True), gather_contacts(members, u, True)
         states_g = gather_contacts(members, states, False)
-        if prefer_sticking(group_matrix(members, W, indptr, indices, blocks), gather_contacts(members, q, True),
-                           gather_contacts(members, mu_s, False), gather_contacts(members, mu_d, False),
-                           gather_contacts(members, start_guess, False), velocity_tol,
-                           gather_contacts(members, closing, False), pg, ug, states_g):
+        start_g = gather_contacts(members, p_start, True) if p_start.shape[0] == p.shape[0] else np.zeros(0)
+        if prefer_sticking_from(group_matrix(members, W, indptr, indices, blocks), gather_contacts(members, q, True),
+                                gather_contacts(members, mu_s, False), gather_contacts(members, mu_d, False),
+                                gather_contacts(members, start_guess, False), velocity_tol,
+                                gather_contacts(members, closing, False), pg, ug, states_g, start_g):
             scatter_contacts(members, pg, ug, states_g, p, u, states)
             changed = True
     return changed
 
 
-__all__ = ["prefer_sticking", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
+__all__ = ["prefer_sticking", "prefer_sticking_from", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
            "scatter_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK", "STATE_SLIP_PLUS",
-           "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE"]
+           "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE", "MODE_LOOSE"]

@@ -205,13 +205,14 @@ def _guess_of_states(states, guess):
 
 @jit
 def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
-                 states):
+                 states, p_start):
     """Hold what μs can hold (sticking.prefer_sticking, group by group of coupled contacts) when a
     contact that started the step at rest — slip velocity round-off at the step's start
     (`resting` 1), slip guess 0 — does not stick; True when p, u, states were replaced. The
     common step returns at once. A contact that was already sliding (or grazing a rolling
     neighbour) keeps the solver's answer: the search costs milliseconds on rows of balls and has
-    nothing to hold there. Groups of more than MAX_DENSE_HOLD contacts keep the solver's split."""
+    nothing to hold there. Groups of more than MAX_DENSE_HOLD contacts keep the solver's split.
+    p_start: the previous step's impulses (the warm start), or empty."""
     na = mu_s.shape[0]
     at_rest = np.empty(na)
     moving = False
@@ -222,7 +223,7 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
     if not moving:
         return False
     return prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, at_rest, velocity_tol, closing, p,
-                                    u, states, MAX_DENSE_HOLD)
+                                    u, states, MAX_DENSE_HOLD, p_start)
 
 
 @jit
@@ -237,7 +238,7 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
     impulse split holds it (hold_at_rest).
     Returns (kernel status, solves, solver iterations, consistent, pgs steps solved again by Lemke)."""
     na = guess.shape[0]
-    start_guess = guess.copy()
+    start_guess, p_start = guess.copy(), p.copy()  # p_start: the warm start, the previous step's split
     lo, hi, new_guess = np.empty(na), np.empty(na), np.empty(na)
     tried = np.empty((MAX_SOLVES + 1, na))
     scale_v = 1e-12
@@ -266,7 +267,7 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
             break
         last = action == NEXT_TRY_ZERO
     if consistent and hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting,
-                                   max(velocity_tol, 10.0 * residual), closing, p, u, states):
+                                   max(velocity_tol, 10.0 * residual), closing, p, u, states, p_start):
         _guess_of_states(states, guess)
     return KERNEL_SOLVED, n_tried, iterations, consistent, fallbacks
 
@@ -355,7 +356,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     p, u = np.array(sol.p, dtype=float), np.array(sol.u, dtype=float)
     empty = np.zeros(0, dtype=np.int64)
     if consistent and hold_at_rest(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess, resting,
-                                   max(velocity_tol, 10.0 * sol.residual), closing, p, u, states):
+                                   max(velocity_tol, 10.0 * sol.residual), closing, p, u, states, np.zeros(0)):
         interpreted(_guess_of_states)(states, guess)
     return StepContactResult(p, u, [STATE_NAMES[s] for s in states], guess.copy(), n_tried, iterations,
                              float(sol.residual), consistent)
