@@ -118,12 +118,16 @@ def _contact_data(contact, bodies, lines, segments) -> dict:
 
 
 def _segment_contact_data(contact, bodies, segments, law) -> dict:
-    """A disk or point on a segment; its segment kept by name in `segments`."""
+    """A disk or point on a segment, or a segment's end on an edge; its segment kept by name in `segments`."""
     segment = contact.segment
     name = next((n for n, known in segments.items() if known == segment), segment.name)
     while name in segments and segments[name] != segment:
         name += "+"
     segments[name] = segment
+    if hasattr(contact, "edge_start"):
+        return {"name": contact.name, "kind": "segment-end-on-edge", "body": bodies[contact.body], "segment": name,
+                "end": contact.end, "edge_start": list(contact.edge_start), "edge_end": list(contact.edge_end),
+                "law": law}
     kind = "disk-on-segment" if contact.radius > 0 else "point-on-segment"
     data = {"name": contact.name, "kind": kind, "body": bodies[contact.body], "segment": name,
             "offset": list(contact.offset), "law": law}

@@ -22,7 +22,7 @@ import numpy as np
 from .integrators import METHODS
 from .model import shapes
 from .model.body import RigidBody
-from .model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment
+from .model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
 from .validation import InputError
@@ -34,7 +34,8 @@ except ModuleNotFoundError:  # Python 3.10: the backport (dependency `tomli; pyt
 
 SCHEMA = "nonsmooth-rod/scene/1"
 SHAPES = ("disk", "ball", "rectangle", "rod", "rod-with-balls")
-CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk", "disk-on-segment", "point-on-segment")
+CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk", "disk-on-segment", "point-on-segment",
+                 "segment-end-on-edge")
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9_+\-]+$")
 OVERLAP_TOLERANCE = 1e-9  # m per metre of the scene's size: penetration allowed in the initial state
 _REQUIRED = object()
@@ -52,6 +53,7 @@ CONTACT_KEYS = {
     "disk-on-disk": ("kind", "name", "body_a", "body_b", "radius_a", "radius_b", "offset_a", "offset_b", "law"),
     "disk-on-segment": ("kind", "name", "body", "offset", "radius", "segment", "law"),
     "point-on-segment": ("kind", "name", "body", "offset", "segment", "law"),
+    "segment-end-on-edge": ("kind", "name", "body", "segment", "end", "edge_start", "edge_end", "law"),
 }
 FORCE_KEYS = {
     "spring": ("kind", "name", "body", "point", "body_b", "point_b", "stiffness", "rest_length", "damping"),
@@ -297,6 +299,17 @@ def _segment_contact(w, t, key, name, kind, body_names, segments):
     return DiskOnSegment(body, _vector(w, t, "offset", key, 2, [0.0, 0.0]), segment, radius, _law(w, t, key), name)
 
 
+def _segment_end_contact(w, t, key, name, body_names, segments):
+    """A segment's end point on a body's straight edge (body frame, counter-clockwise)."""
+    body = _lookup(w, body_names, t.get("body"), f"{key}.body", "body")
+    segment = list(segments.values())[_lookup(w, list(segments), t.get("segment"), f"{key}.segment", "segment")]
+    end = _text(w, t, "end", key, "b", choices=("a", "b"))
+    start, stop = _vector(w, t, "edge_start", key, 2), _vector(w, t, "edge_end", key, 2)
+    if start == stop:
+        raise w.error(f"{key}.edge_end", f"equals edge_start = {list(start)}: an edge of length 0")
+    return SegmentEndOnEdge(body, start, stop, segment, end, _law(w, t, key), name)
+
+
 def _law(w, t, key) -> ContactLaw:
     law = t.get("law", {})
     key = f"{key}.law"
@@ -336,6 +349,8 @@ def _contacts(w, data, body_names, lines, segments=None) -> list:
         _check_keys(w, t, CONTACT_KEYS[kind], key)
         if kind.endswith("-on-segment"):
             contacts.append(_segment_contact(w, t, key, name, kind, body_names, segments or {}))
+        elif kind == "segment-end-on-edge":
+            contacts.append(_segment_end_contact(w, t, key, name, body_names, segments or {}))
         else:
             contacts.append(_contact(w, t, key, name, kind, body_names, lines))
     return contacts

@@ -83,6 +83,36 @@ def test_a_disk_rolling_off_a_table_leaves_the_edge_at_the_closed_form_angle(k):
     assert abs(np.interp(r.phases["table"][1].t_start, tr.t, phi) - expected) <= 3 * rate * h
 
 
+def test_a_block_slides_over_the_end_of_a_table_tips_on_its_edge_and_falls():
+    """A 0.2 × 0.1 block slides (μ = 0.3) towards the end of a table: its corners on the segment,
+    the table's end point on its bottom edge. Sliding, it decelerates at μ g, x(t) = x0 + v0 t −
+    μ g t²/2. Its right corner leaves the table when x = −w/2. With the bottom edge on the table's
+    end and both contacts sliding, the moments about the end point (m g x, and m μ g h/2 of the
+    deceleration at the centre's height h/2) lift the left corner when x = −μ h/2, before the
+    centre of mass passes the edge; the block then pivots and slides on the edge, and falls."""
+    w, height, mu, x0, v0, h = 0.2, 0.1, 0.3, -0.5, 2.0, 1e-4
+    law = nr.ContactLaw.of(mu, mu, 0.0)
+    corners = [nr.PointOnSegment(0, (-w / 2, -height / 2), TABLE, law, "left"),
+               nr.PointOnSegment(0, (w / 2, -height / 2), TABLE, law, "right")]
+    edge = nr.SegmentEndOnEdge(0, (-w / 2, -height / 2), (w / 2, -height / 2), TABLE, "b", law, "edge")
+    scene = nr.Scene([nr.RigidBody(M, M * (w**2 + height**2) / 12)], corners + [edge], gravity=G)
+    r = nr.simulate(scene, np.array([x0, height / 2, 0.0]), np.array([v0, 0.0, 0.0]), 0.6, "moreau-jean", h=h)
+    assert r.status == nr.Status.OK
+    phases = {name: [p.mode for p in ph] for name, ph in r.phases.items()}
+    assert phases == {"left": ["slip+", "open"], "right": ["slip+", "open"], "edge": ["open", "slip+", "open"]}
+
+    def reaches(x):  # when the sliding block's centre reaches x
+        return (v0 - math.sqrt(v0**2 - 2 * mu * G * (x - x0))) / (mu * G)
+
+    assert r.phases["right"][1].t_start == pytest.approx(reaches(-w / 2), abs=3 * h)
+    assert r.phases["edge"][1].t_start == pytest.approx(reaches(-w / 2), abs=3 * h)
+    assert r.phases["left"][1].t_start == pytest.approx(reaches(-mu * height / 2), abs=3 * h)
+    # the table's end never enters the block, and the block ends below the table
+    gaps = [edge.kinematics(q, v, 3).gap for q, v in zip(r.trajectory.q, r.trajectory.v)]
+    assert min(gaps) > -1e-6
+    assert r.trajectory.q[-1, 1] < -0.2 and np.all(r.trajectory.normal_force[r.trajectory.t > 0.5] == 0.0)
+
+
 def test_the_event_driven_reference_refuses_segments_in_one_line():
     with pytest.raises(InputError, match="event-driven.*does not handle DiskOnSegment contacts"):
         nr.simulate(_ball_scene(), np.array([-0.5, 0.4, 0.0]), np.zeros(3), 0.1, "event-driven")

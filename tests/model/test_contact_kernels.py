@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment
+from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
 from nonsmooth_rod.model.packing import contact_kinematics, pack_contacts
 from nonsmooth_rod.validation import InputError
 
@@ -182,3 +182,47 @@ def test_a_changed_field_is_repacked():
     assert c.kinematics(q, np.zeros(3), 3).gap == pytest.approx(0.9)
     c.radius = 0.3
     assert c.kinematics(q, np.zeros(3), 3).gap == pytest.approx(0.7)
+
+
+BOX_EDGE = ((-0.1, -0.05), (0.1, -0.05))  # the bottom of a 0.2 × 0.1 box, counter-clockwise
+
+
+def _put_edge_over_segment_end(where):
+    """Move body 0 so that the segment's end b lies along its bottom edge, or beyond an end of it."""
+    def place(q):
+        fraction = {"along": 0.3, "beyond-start": -0.4, "beyond-end": 1.5}[where]
+        start, end = np.array(BOX_EDGE[0]), np.array(BOX_EDGE[1])
+        point_on_edge = _rotate(q[2], start + fraction * (end - start))
+        outward = _rotate(q[2], (0.0, -1.0))
+        q[0:2] = np.array(SEG.b) - point_on_edge - 0.02 * outward  # the end point 2 cm outside
+    return place
+
+
+EDGE_CASES = [(f"end on edge {w}", SegmentEndOnEdge(0, *BOX_EDGE, SEG, "b"), 1, _put_edge_over_segment_end(w))
+              for w in ("along", "beyond-start", "beyond-end")]
+
+
+@pytest.mark.parametrize("label, contact, n_bodies, place", EDGE_CASES, ids=[c[0] for c in EDGE_CASES])
+def test_segment_end_on_an_edge_is_the_derivatives_of_its_geometry(label, contact, n_bodies, place):
+    rng = np.random.default_rng(24)
+    for _ in range(20):
+        q, v = _random_state(rng, n_bodies, place)
+        k = contact.kinematics(q, v, q.size)
+        plus, minus = _along(contact, q, v, 1), _along(contact, q, v, -1)
+        scale = 1.0 + np.abs(v).max() ** 2
+        p = np.array(SEG.b)
+        start, end = (q[0:2] + _rotate(q[2], e) for e in BOX_EDGE)
+        s = np.clip(np.dot(p - start, end - start) / np.dot(end - start, end - start), 0.0, 1.0)
+        assert k.gap == pytest.approx(np.linalg.norm(p - (start + s * (end - start))), abs=1e-12)  # 2 cm or the corner's
+        n = k.H_N[:2]
+        touching = p if label.endswith("along") else start + s * (end - start)
+        t = np.array([n[1], -n[0]])
+        assert k.H_T @ v == pytest.approx(np.dot(t, _material_velocity(q, v, 0, touching)), rel=1e-7, abs=1e-7 * scale)
+        assert k.H_N @ v == pytest.approx((plus.gap - minus.gap) / (2 * EPS), rel=1e-7, abs=1e-7 * scale)
+        assert k.drift_N == pytest.approx((plus.H_N @ v - minus.H_N @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+        assert k.drift_T == pytest.approx((plus.H_T @ v - minus.H_T @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+    table, index = pack_contacts([contact], n_bodies)
+    hn, ht = np.zeros(6), np.zeros(6)
+    gap, drift = contact_kinematics(table, index, 0, q, v, hn, ht)
+    np.testing.assert_allclose([gap, drift, *hn[:3], *ht[:3]], [k.gap, k.drift_N, *k.H_N, *k.H_T], rtol=1e-13,
+                               atol=1e-14)

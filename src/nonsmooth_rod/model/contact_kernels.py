@@ -21,12 +21,14 @@ import math
 
 from .._jit import jitable
 
-KIND_DISK_ON_LINE, KIND_DISK_ON_DISK, KIND_DISK_ON_SEGMENT = 0, 1, 2
+KIND_DISK_ON_LINE, KIND_DISK_ON_DISK, KIND_DISK_ON_SEGMENT, KIND_SEGMENT_END_ON_EDGE = 0, 1, 2, 3
 # Float columns of a contact row. A segment stores its end a in C_LINE_P*, its unit direction
-# a → b in C_T*, its left normal in C_N* and its length in C_SEGMENT_LENGTH.
+# a → b in C_T*, its left normal in C_N* and its length in C_SEGMENT_LENGTH. A segment's end on
+# a body's edge: the end point in C_LINE_P*, the edge's start in C_OFF_A*, its unit direction
+# (body frame) in C_EDGE_T* and its length in C_SEGMENT_LENGTH.
 (C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_OFF_BX, C_OFF_BY, C_RADIUS_B, C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_TX,
- C_TY, C_SURFACE_VELOCITY, C_MU_S, C_MU_D, C_RESTITUTION, C_SEGMENT_LENGTH) = range(17)
-N_CONTACT_COLUMNS = 17
+ C_TY, C_SURFACE_VELOCITY, C_MU_S, C_MU_D, C_RESTITUTION, C_SEGMENT_LENGTH, C_EDGE_TX, C_EDGE_TY) = range(19)
+N_CONTACT_COLUMNS = 19
 
 
 @jitable
@@ -121,18 +123,52 @@ def _disk_on_segment(row, body, q, v, hn, ht):
             nx, ny = -nx, -ny
         return _on_fixed_normal(row, body, q, v, hn, ht, nx, ny, ax, ay)
     end = min(max(along, 0.0), row[C_SEGMENT_LENGTH])
-    rx, ry = cx - end * ex, cy - end * ey  # from the end point to the disk centre
+    return _on_fixed_point(body, dx, dy, row[C_RADIUS_A], ax + end * ex, ay + end * ey, q, v, hn, ht)
+
+
+@jitable
+def _on_fixed_point(body, dx, dy, r, px, py, q, v, hn, ht):
+    """A disk of radius r centred at offset d (world frame) from body a's centre of mass against
+    the fixed point p: the normal from p to the centre."""
+    j = 3 * body
+    rx, ry = q[j] + dx - px, q[j + 1] + dy - py
     dist = math.sqrt(rx * rx + ry * ry)
     if dist == 0.0:
         return math.nan, math.nan, math.nan
     nx, ny = rx / dist, ry / dist
-    r = row[C_RADIUS_A]
     _fill_rows(hn, ht, 0, nx, ny, dx - r * nx, dy - r * ny, 1.0)
     _clear_side(hn, ht, 1)
     wx, wy = _centre_velocity(body, dx, dy, v)
     om = v[j + 2]
     drift_n, drift_t = _turning_drifts(wx, wy, nx, ny, dist, -om * om * dx, -om * om * dy)
     return dist - r, drift_n, drift_t
+
+
+@jitable
+def _segment_end_on_edge(row, body, q, v, hn, ht):
+    """A segment's end point p against an edge of body a (start e, unit direction τ, body frame;
+    the body on its left, so its outward normal is τ turned by −90°). While p lies along the
+    edge, the normal is the edge's inward normal and the touching material point is the one at p;
+    beyond the edge's ends, the edge's end point nearest p touches it (the body's corner)."""
+    j = 3 * body
+    c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
+    ex, ey = _body_point(row, body, q, C_OFF_AX, C_OFF_AY)
+    tx, ty = c * row[C_EDGE_TX] - s * row[C_EDGE_TY], s * row[C_EDGE_TX] + c * row[C_EDGE_TY]
+    px, py = row[C_LINE_PX], row[C_LINE_PY]
+    along = (px - q[j] - ex) * tx + (py - q[j + 1] - ey) * ty
+    if not 0.0 <= along <= row[C_SEGMENT_LENGTH]:
+        end = min(max(along, 0.0), row[C_SEGMENT_LENGTH])
+        return _on_fixed_point(body, ex + end * tx, ey + end * ty, 0.0, px, py, q, v, hn, ht)
+    nx, ny = -ty, tx  # inward: from the obstacle's point into the body
+    rho_x, rho_y = px - q[j], py - q[j + 1]
+    _fill_rows(hn, ht, 0, nx, ny, rho_x, rho_y, 1.0)
+    _clear_side(hn, ht, 1)
+    # The edge turns with the body and the touching material point changes as the body moves:
+    # d/dt (n·v + ω ρ×n) = 2 ω n×v + ω² ρ·n, likewise for t.
+    om, vx, vy = v[j + 2], v[j], v[j + 1]
+    gap = -(nx * (px - q[j] - ex) + ny * (py - q[j + 1] - ey))
+    return (gap, 2.0 * om * (nx * vy - ny * vx) + om * om * (rho_x * nx + rho_y * ny),
+            2.0 * om * (ny * vy + nx * vx) + om * om * (rho_x * ny - rho_y * nx))
 
 
 @jitable
@@ -143,4 +179,6 @@ def kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht):
         return _on_fixed_normal(row, body_a, q, v, hn, ht, row[C_NX], row[C_NY], row[C_LINE_PX], row[C_LINE_PY])
     if kind == KIND_DISK_ON_SEGMENT:
         return _disk_on_segment(row, body_a, q, v, hn, ht)
+    if kind == KIND_SEGMENT_END_ON_EDGE:
+        return _segment_end_on_edge(row, body_a, q, v, hn, ht)
     return _disk_on_disk(row, body_a, body_b, q, v, hn, ht)

@@ -24,8 +24,8 @@ import numpy as np
 from ..validation import InputError, require_finite, require_index, require_nonnegative, require_point
 from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_AY, C_OFF_BX, C_OFF_BY,
                               C_RADIUS_A, C_RADIUS_B, C_SEGMENT_LENGTH, C_SURFACE_VELOCITY, C_TX, C_TY,
-                              KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, N_CONTACT_COLUMNS,
-                              kinematics_kernel)
+                              C_EDGE_TX, C_EDGE_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT,
+                              KIND_SEGMENT_END_ON_EDGE, N_CONTACT_COLUMNS, kinematics_kernel)
 from .laws import ContactLaw
 
 
@@ -237,6 +237,52 @@ class DiskOnSegment(_PackedRelation):
 def PointOnSegment(body: int, offset, segment: Segment, law: ContactLaw | None = None, name="corner"):
     """A body-fixed point (a corner) touching a segment: a disk of radius zero."""
     return DiskOnSegment(body, tuple(offset), segment, 0.0, law or ContactLaw(), name)
+
+
+@dataclass
+class SegmentEndOnEdge(_PackedRelation):
+    """An end point (`end`: "a" or "b") of a fixed Segment against the straight edge of `body`
+    from `edge_start` to `edge_end` (body frame, the body on the edge's left: a counter-clockwise
+    outline), e.g. a table's edge under a box's bottom. Beyond the edge's ends the edge's nearest
+    end (the body's corner) touches the point; declare that corner's own contact with the
+    segment beside this one."""
+
+    body: int
+    edge_start: tuple[float, float]
+    edge_end: tuple[float, float]
+    segment: Segment
+    end: str = "b"
+    law: ContactLaw = field(default_factory=ContactLaw)
+    name: str = "edge"
+
+    _no_normal = "the segment's end point is on the body's corner, the contact normal is undefined"
+
+    def __post_init__(self):
+        self.name = _contact_name(self.name)
+        self.body = require_index(f"contact {self.name!r} body", self.body)
+        self.edge_start = require_point(f"contact {self.name!r} edge_start", self.edge_start)
+        self.edge_end = require_point(f"contact {self.name!r} edge_end", self.edge_end)
+        _require_type(f"contact {self.name!r} segment", self.segment, Segment)
+        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
+        if self.end not in ("a", "b"):
+            raise InputError(f"contact {self.name!r} end must be 'a' or 'b' (which end of the segment), "
+                             f"got {self.end!r}")
+        if self.edge_start == self.edge_end:
+            raise InputError(f"contact {self.name!r}: edge_start and edge_end coincide (an edge of length 0)")
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return (self.body,)
+
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the geometry into a packed row; returns (kind, body a, body b)."""
+        _fill_disk_a(row, self.edge_start, 0.0)
+        row[C_LINE_PX], row[C_LINE_PY] = self.segment.a if self.end == "a" else self.segment.b
+        length = math.hypot(self.edge_end[0] - self.edge_start[0], self.edge_end[1] - self.edge_start[1])
+        row[C_EDGE_TX] = (self.edge_end[0] - self.edge_start[0]) / length
+        row[C_EDGE_TY] = (self.edge_end[1] - self.edge_start[1]) / length
+        row[C_SEGMENT_LENGTH] = length
+        return KIND_SEGMENT_END_ON_EDGE, self.body, -1
 
 
 @dataclass

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
-from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment
+from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge
 from ..validation import InputError
 
 
@@ -45,6 +45,8 @@ def _contact_parts(scene, body: int) -> list:
     for c in scene.contacts:
         if isinstance(c, (DiskOnLine, DiskOnSegment)) and c.body == body:
             parts.append((tuple(c.offset), c.radius))
+        elif isinstance(c, SegmentEndOnEdge) and c.body == body:
+            parts += [(tuple(c.edge_start), 0.0), (tuple(c.edge_end), 0.0)]
         elif isinstance(c, DiskOnDisk):
             if c.body_a == body:
                 parts.append((tuple(c.offset_a), c.radius_a))
@@ -182,11 +184,14 @@ def contact_frames(scene, q: np.ndarray) -> list[tuple]:
             d = ca - cb
             n = d / max(np.linalg.norm(d), 1e-300)
             out.append((ca - c.radius_a * n, n, np.array([n[1], -n[0]])))
-        elif isinstance(c, DiskOnSegment):  # the normal of the feature touched: from the kinematics
+        elif isinstance(c, (DiskOnSegment, SegmentEndOnEdge)):  # the touched feature's normal: from the kinematics
             j = 3 * c.body
             k = c.kinematics(q, np.zeros_like(q), q.size)
             n, t = k.H_N[j : j + 2], k.H_T[j : j + 2]
-            out.append((_world(q, j, c.offset) - c.radius * n, n, t))
+            if isinstance(c, SegmentEndOnEdge):  # at the segment's end point
+                out.append((np.array(c.segment.a if c.end == "a" else c.segment.b), n, t))
+            else:
+                out.append((_world(q, j, c.offset) - c.radius * n, n, t))
         else:
             centre = _world(q, 3 * c.body, c.offset)
             n, t = np.array(c.line.normal), np.array(c.line.tangent)
