@@ -17,6 +17,7 @@ its `kinematics` calls the kernel of its kind with that row.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -112,6 +113,18 @@ class ContactKinematics:
     surface_velocity: float = 0.0  # subtracted from H_T v to get the slip velocity
 
 
+# Each relation's packed row, by id, beside a weak reference that tells a live relation from a
+# dead one whose id was reused. Kept out of the instances so that their __dict__ stays their
+# fields (type(c)(**c.__dict__) copies a relation).
+_PACKED_ROWS: dict = {}
+
+
+def _forget_row(ref, key) -> None:
+    entry = _PACKED_ROWS.get(key)
+    if entry is not None and entry[0] is ref:
+        del _PACKED_ROWS[key]
+
+
 class _PackedRelation:
     """What every relation shares: its packed row (written by `fill_row`, kept until a field
     changes) and `kinematics` from the kernel of its kind."""
@@ -120,16 +133,18 @@ class _PackedRelation:
 
     def __setattr__(self, name, value):
         object.__setattr__(self, name, value)
-        object.__setattr__(self, "_packed", None)  # any change of geometry re-packs
+        _PACKED_ROWS.pop(id(self), None)  # any change of geometry re-packs
 
     def _packed_row(self):
-        packed = getattr(self, "_packed", None)
-        if packed is None:
-            row = [0.0] * N_CONTACT_COLUMNS  # a list: the kernel's scalar reads are cheapest there
-            kind, body_a, body_b = self.fill_row(row)
-            packed = (kind, body_a, body_b, row)
-            object.__setattr__(self, "_packed", packed)
-        return packed
+        entry = _PACKED_ROWS.get(id(self))
+        if entry is not None and entry[0]() is self:
+            return entry[1]
+        row = [0.0] * N_CONTACT_COLUMNS  # a list: the kernel's scalar reads are cheapest there
+        kind, body_a, body_b = self.fill_row(row)
+        key = id(self)
+        ref = weakref.ref(self, lambda r, key=key: _forget_row(r, key))
+        _PACKED_ROWS[key] = (ref, (kind, body_a, body_b, row))
+        return kind, body_a, body_b, row
 
     def kinematics(self, q, v, n_dof: int) -> ContactKinematics:
         """The kernel of this contact's kind at (q, v): arrays, or lists (Scene.kinematics hands
