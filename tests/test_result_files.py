@@ -109,3 +109,21 @@ def test_repeated_body_names_fall_back_to_numbered_columns():
     contacts = [nr.DiskOnLine(i, (0.0, 0.0), line, 0.1, nr.ContactLaw.of(0.3), f"c{i}") for i in (0, 1)]
     result = nr.simulate(nr.Scene([body, body], contacts), [0, 0.1, 0, 1, 0.1, 0], [0] * 6, 0.01, h=1e-3)
     assert list(to_dataframe(result).columns[1:8:6]) == ["body0.x", "body1.x"]
+
+
+def test_a_flat_api_run_with_a_segment_describes_it_in_the_scene_file_layout(tmp_path):
+    import json
+
+    table = nr.Segment((-1.0, 0.0), (0.0, 0.0), name="table")
+    scene = nr.Scene([nr.RigidBody(1.0, 0.005)], [nr.DiskOnSegment(0, (0.0, 0.0), table, 0.1, name="edge"),
+                                                  nr.PointOnSegment(0, (0.0, -0.1), table, name="low"),
+                                                  nr.SegmentEndOnEdge(0, (-0.1, -0.1), (0.1, -0.1), table, "b",
+                                                                      name="rim")])
+    result = nr.simulate(scene, np.array([-0.5, 0.2, 0.0]), np.zeros(3), 0.01, "moreau-jean", h=1e-3)
+    result.save(tmp_path / "out")
+    params = json.loads((tmp_path / "out" / "summary.json").read_text())["params"]
+    assert params["segments"] == [{"name": "table", "a": [-1.0, 0.0], "b": [0.0, 0.0]}]
+    kinds = [(c["kind"], c["segment"], c.get("radius")) for c in params["contacts"]]
+    assert kinds == [("disk-on-segment", "table", 0.1), ("point-on-segment", "table", None),
+                     ("segment-end-on-edge", "table", None)]
+    assert params["contacts"][2]["edge_start"] == [-0.1, -0.1] and params["contacts"][2]["end"] == "b"

@@ -313,3 +313,46 @@ def test_the_docs_python_example_runs(monkeypatch):
     exec(compile(code, str(doc), "exec"), namespace)  # noqa: S102 (the doc's own example)
     result = namespace["result"]
     assert result.success and [p.mode for p in result.phases["foot"]] == ["slip+"]  # mu_s = 0.2 < cot 60° / 2
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d["segments"][0].update(b=[-1.0, 0.0]), "segments.table.b: equals a = [-1.0, 0.0]: a segment of length 0"),
+    (lambda d: d["segments"][0].pop("b"), "segments.table.b: missing"),
+    (lambda d: d["segments"][0].update(point=[0, 0]), "segments.table.point: unknown key"),
+    (lambda d: d["contacts"][0].update(segment="tabel"), "contacts.edge.segment: no segment named 'tabel' (have: table)"),
+    (lambda d: d["contacts"][0].update(kind="point-on-segment"), "contacts.edge.radius: unknown key"),
+    (lambda d: d["contacts"][0].update(line="table"), "contacts.edge.line: unknown key"),
+    (lambda d: d["initial"]["disk"].update(q=[-0.5, 0.05, 0.0]), "contact 'edge' starts overlapping by 0.05 m"),
+])
+def test_segments_and_their_contacts_read_from_a_file_and_refuse_mistakes_in_one_line(edit, message):
+    from nonsmooth_rod.model.contacts import DiskOnSegment
+
+    sf = load_scene(SCENES / "ball_off_table.toml")
+    (contact,) = sf.scene.contacts
+    assert isinstance(contact, DiskOnSegment) and contact.radius == 0.1 and list(sf.segments) == ["table"]
+    assert (contact.segment.a, contact.segment.b, contact.segment.normal) == ((-1.0, 0.0), (0.0, 0.0), (-0.0, 1.0))
+    data = copy.deepcopy(sf.data)
+    edit(data)
+    with pytest.raises(InputError) as err:
+        parse_scene(data, source="my.toml")
+    assert message in str(err.value) and "\n" not in str(err.value) and str(err.value).startswith("my.toml")
+
+
+def test_a_segment_end_on_a_box_edge_reads_from_a_file_and_refuses_a_zero_edge():
+    from nonsmooth_rod.model.contacts import SegmentEndOnEdge
+
+    data = {"schema": "nonsmooth-rod/scene/1", "bodies": [{"name": "box", "shape": "rectangle", "width": 0.2,
+                                                           "height": 0.1, "mass": 1.0}],
+            "segments": [{"name": "table", "a": [-1.0, 0.0], "b": [0.0, 0.0]}],
+            "contacts": [{"kind": "segment-end-on-edge", "name": "edge", "body": "box", "segment": "table",
+                          "edge_start": [-0.1, -0.05], "edge_end": [0.1, -0.05], "law": {"mu_s": 0.3}}],
+            "initial": {"box": {"q": [-0.05, 0.05, 0.0]}}, "simulation": {"t_end": 0.1}}
+    (edge,) = parse_scene(copy.deepcopy(data), source="box.toml").scene.contacts
+    assert isinstance(edge, SegmentEndOnEdge) and edge.end == "b" and edge.edge_end == (0.1, -0.05)
+    assert edge.kinematics(np.array([-0.05, 0.05, 0.0]), np.zeros(3), 3).gap == 0.0  # the end under the bottom
+    data["contacts"][0]["edge_end"] = [-0.1, -0.05]
+    with pytest.raises(InputError, match=r"^box.toml: contacts.edge.edge_end: equals edge_start = \[-0.1, -0.05\]"):
+        parse_scene(data, source="box.toml")
+    data["contacts"][0].update(edge_end=[0.1, -0.05], end="c")
+    with pytest.raises(InputError, match=r"^box.toml: contacts.edge.end: must be one of"):
+        parse_scene(data, source="box.toml")

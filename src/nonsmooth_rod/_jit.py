@@ -78,6 +78,19 @@ def jit(function):
     return numba.njit(cache=True)(function)
 
 
+def jitable(function):
+    """A kernel both ways: plain Python when Python calls it (it never waits for a compile), and
+    compiled into the jitted kernels that call it (numba's register_jitable). For code that the
+    compiled loop and the object model share (model/contact_kernels.py)."""
+    if not ENABLED:
+        return function
+    from numba.extending import register_jitable
+
+    if not _purged:
+        purge_stale_kernels()
+    return register_jitable(function)
+
+
 # ---------------------------------------------------------------- stale cached kernels
 # numba recompiles a cached kernel when its own source file changes, not when a kernel it calls
 # (and compiled into itself) changes: after an edit of solvers/lemke.py the Moreau–Jean loop

@@ -100,17 +100,36 @@ def _law_data(law) -> dict:
     return {"mu_s": law.friction.mu_s, "mu_d": law.friction.mu_d, "restitution": law.impact.restitution}
 
 
-def _contact_data(contact, bodies, lines) -> dict:
+def _contact_data(contact, bodies, lines, segments) -> dict:
     law = _law_data(contact.law)
     if hasattr(contact, "body_a"):
         return {"name": contact.name, "kind": "disk-on-disk", "body_a": bodies[contact.body_a],
                 "body_b": bodies[contact.body_b], "radius_a": contact.radius_a, "radius_b": contact.radius_b,
                 "offset_a": list(contact.offset_a), "offset_b": list(contact.offset_b), "law": law}
+    if hasattr(contact, "segment"):
+        return _segment_contact_data(contact, bodies, segments, law)
     line = contact.line
     name = next((n for n, known in lines.items() if known == line), f"line{len(lines)}")
     lines[name] = line
     kind = "disk-on-line" if contact.radius > 0 else "point-on-line"
     data = {"name": contact.name, "kind": kind, "body": bodies[contact.body], "line": name,
+            "offset": list(contact.offset), "law": law}
+    return data | ({"radius": contact.radius} if contact.radius > 0 else {})
+
+
+def _segment_contact_data(contact, bodies, segments, law) -> dict:
+    """A disk or point on a segment, or a segment's end on an edge; its segment kept by name in `segments`."""
+    segment = contact.segment
+    name = next((n for n, known in segments.items() if known == segment), segment.name)
+    while name in segments and segments[name] != segment:
+        name += "+"
+    segments[name] = segment
+    if hasattr(contact, "edge_start"):
+        return {"name": contact.name, "kind": "segment-end-on-edge", "body": bodies[contact.body], "segment": name,
+                "end": contact.end, "edge_start": list(contact.edge_start), "edge_end": list(contact.edge_end),
+                "law": law}
+    kind = "disk-on-segment" if contact.radius > 0 else "point-on-segment"
+    data = {"name": contact.name, "kind": kind, "body": bodies[contact.body], "segment": name,
             "offset": list(contact.offset), "law": law}
     return data | ({"radius": contact.radius} if contact.radius > 0 else {})
 
@@ -133,13 +152,16 @@ def scene_description(result) -> dict | None:
         return None
     scene, bodies = inputs["scene"], body_names_of(result)
     lines: dict = {}
-    contacts = [_contact_data(c, bodies, lines) for c in scene.contacts]
+    segments: dict = {}
+    contacts = [_contact_data(c, bodies, lines, segments) for c in scene.contacts]
     q0, v0 = np.asarray(inputs["q0"], float), np.asarray(inputs["v0"], float)
     return {
         "gravity": scene.gravity,
         "bodies": [{"name": n, "mass": b.mass, "inertia": b.inertia} for n, b in zip(bodies, scene.bodies)],
         "lines": [{"name": n, "point": list(line.point), "angle_deg": math.degrees(line.angle),
                    "velocity": line.velocity} for n, line in lines.items()],
+        **({"segments": [{"name": n, "a": list(s.a), "b": list(s.b)} for n, s in segments.items()]}
+           if segments else {}),
         "contacts": contacts, "forces": [_force_data(f, bodies) for f in scene.forces],
         "applied_force": _plain(scene.applied_force),
         "initial": {n: {"q": q0[3 * i:3 * i + 3].tolist(), "v": v0[3 * i:3 * i + 3].tolist()}

@@ -22,7 +22,7 @@ import numpy as np
 from .integrators import METHODS
 from .model import shapes
 from .model.body import RigidBody
-from .model.contacts import DiskOnDisk, DiskOnLine, Line
+from .model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
 from .model.laws import ContactLaw
 from .scene_forces import FORCE_KINDS, build_force, make_scene
 from .validation import MAX_INTEGER, MAX_STATE, InputError, quoted, require_finite
@@ -34,22 +34,27 @@ except ModuleNotFoundError:  # Python 3.10: the backport (dependency `tomli; pyt
 
 SCHEMA = "nonsmooth-rod/scene/1"
 SHAPES = ("disk", "ball", "rectangle", "rod", "rod-with-balls")
-CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk")
+CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk", "disk-on-segment", "point-on-segment",
+                 "segment-end-on-edge")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_+\-]{1,200}")  # fullmatch: no trailing newline
 OVERLAP_TOLERANCE = 1e-9  # m per metre of the scene's size: penetration allowed in the initial state
 _REQUIRED = object()
 MAX_DEPTH = 16  # tables and lists nest at most this deep (a scene needs 4)
 
-TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "contacts", "forces",
+TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "segments", "contacts", "forces",
             "initial", "simulation")
 BODY_KEYS = ("name", "mass", "inertia", "shape", "density", "thickness", "radius", "width", "height",
              "length", "ball_radius", "rod_diameter")
 LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length")
+SEGMENT_KEYS = ("name", "a", "b")
 LAW_KEYS = ("mu_s", "mu_d", "restitution")
 CONTACT_KEYS = {
     "disk-on-line": ("kind", "name", "body", "offset", "radius", "line", "law"),
     "point-on-line": ("kind", "name", "body", "offset", "line", "law"),
     "disk-on-disk": ("kind", "name", "body_a", "body_b", "radius_a", "radius_b", "offset_a", "offset_b", "law"),
+    "disk-on-segment": ("kind", "name", "body", "offset", "radius", "segment", "law"),
+    "point-on-segment": ("kind", "name", "body", "offset", "segment", "law"),
+    "segment-end-on-edge": ("kind", "name", "body", "segment", "end", "edge_start", "edge_end", "law"),
 }
 FORCE_KEYS = {
     "spring": ("kind", "name", "body", "point", "body_b", "point_b", "stiffness", "rest_length", "damping"),
@@ -82,6 +87,7 @@ class SceneFile:
     title: str = ""
     text: str = ""  # the file as read (for a copy next to the results)
     overrides: list = field(default_factory=list)
+    segments: dict = field(default_factory=dict)  # segment name -> Segment
 
 
 class _Where:
@@ -288,6 +294,37 @@ def _lines(w, data) -> dict:
     return lines
 
 
+def _segments(w, data) -> dict:
+    segments = {}
+    for name, t in _items(w, data, "segments"):
+        key = f"segments.{name}"
+        _check_keys(w, t, SEGMENT_KEYS, key)
+        a, b = _vector(w, t, "a", key, 2), _vector(w, t, "b", key, 2)
+        if a == b:
+            raise w.error(f"{key}.b", f"equals a = {list(a)}: a segment of length 0")
+        segments[name] = Segment(a, b, name)
+    return segments
+
+
+def _segment_contact(w, t, key, name, kind, body_names, segments):
+    """A disk (or a body point, radius 0) on a segment: its interior or its nearest end."""
+    body = _lookup(w, body_names, t.get("body"), f"{key}.body", "body")
+    segment = list(segments.values())[_lookup(w, list(segments), t.get("segment"), f"{key}.segment", "segment")]
+    radius = _number(w, t, "radius", key, nonnegative=True) if kind == "disk-on-segment" else 0.0
+    return DiskOnSegment(body, _vector(w, t, "offset", key, 2, [0.0, 0.0]), segment, radius, _law(w, t, key), name)
+
+
+def _segment_end_contact(w, t, key, name, body_names, segments):
+    """A segment's end point on a body's straight edge (body frame, counter-clockwise)."""
+    body = _lookup(w, body_names, t.get("body"), f"{key}.body", "body")
+    segment = list(segments.values())[_lookup(w, list(segments), t.get("segment"), f"{key}.segment", "segment")]
+    end = _text(w, t, "end", key, "b", choices=("a", "b"))
+    start, stop = _vector(w, t, "edge_start", key, 2), _vector(w, t, "edge_end", key, 2)
+    if start == stop:
+        raise w.error(f"{key}.edge_end", f"equals edge_start = {list(start)}: an edge of length 0")
+    return SegmentEndOnEdge(body, start, stop, segment, end, _law(w, t, key), name)
+
+
 def _law(w, t, key) -> ContactLaw:
     law = t.get("law", {})
     key = f"{key}.law"
@@ -319,13 +356,18 @@ def _contact(w, t, key, name, kind, body_names, lines):
     return DiskOnLine(body, _vector(w, t, "offset", key, 2, [0.0, 0.0]), line, radius, law, name)
 
 
-def _contacts(w, data, body_names, lines) -> list:
+def _contacts(w, data, body_names, lines, segments=None) -> list:
     contacts = []
     for name, t in _items(w, data, "contacts"):
         key = f"contacts.{name}"
         kind = _text(w, t, "kind", key, choices=CONTACT_KINDS)
         _check_keys(w, t, CONTACT_KEYS[kind], key)
-        contacts.append(_contact(w, t, key, name, kind, body_names, lines))
+        if kind.endswith("-on-segment"):
+            contacts.append(_segment_contact(w, t, key, name, kind, body_names, segments or {}))
+        elif kind == "segment-end-on-edge":
+            contacts.append(_segment_end_contact(w, t, key, name, body_names, segments or {}))
+        else:
+            contacts.append(_contact(w, t, key, name, kind, body_names, lines))
     return contacts
 
 
@@ -626,8 +668,8 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
         _text(w, data, key, "", "")
     gravity = _number(w, data, "gravity", "", 9.81, nonnegative=True)
     bodies, body_names, shapes = _bodies(w, data)
-    lines = _lines(w, data)
-    contacts = _contacts(w, data, body_names, lines)
+    lines, segments = _lines(w, data), _segments(w, data)
+    contacts = _contacts(w, data, body_names, lines, segments)
     forces = _forces(w, data, body_names)
     try:
         with np.errstate(all="ignore"):
@@ -642,7 +684,7 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     method, t_end, options, stop = _simulation(w, data, contact_names)
     return SceneFile(scene, q0, v0, t_end, method, options, stop, body_names, contact_names, list(lines),
                      [f.name for f in forces], shapes, lines, data, source,
-                     title=str(data.get("title", "")))
+                     title=str(data.get("title", "")), segments=segments)
 
 
 # --- running ----------------------------------------------------------------------------------------

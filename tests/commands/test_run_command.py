@@ -36,7 +36,7 @@ def modes(summary, contact):
 
 def test_every_shipped_scene_has_a_test():
     tested = {"bouncing_ball", "block_on_incline", "pushed_block", "disk_on_incline", "belt_oscillator",
-              "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod"}
+              "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod", "ball_off_table"}
     assert {p.stem for p in SCENES.glob("*.toml")} == tested
 
 
@@ -106,6 +106,20 @@ def test_painleve_rod_stops_at_the_band_edge_with_exit_status_1(tmp_path, capsys
     assert c["rod.theta"][-1] == pytest.approx(toys.PainleveRod().painleve_band()[0], abs=1e-8)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "painleve" in err
+
+
+def test_ball_off_table_leaves_the_edge_at_the_rolling_closed_form(tmp_path):
+    """A disk rolls off the end of a table segment, pivots on its edge and leaves it at
+    cos φ* = (2 + (1 + k) v0²/(g R)) / (3 + k) (the file's comment derives it), within 3 steps."""
+    h, k, v0, radius, g = 1e-4, 0.5, 0.5, 0.1, 9.81
+    s, c = run(tmp_path, "ball_off_table", f"--set=simulation.moreau-jean.h={h}")
+    assert modes(s, "edge") == ["stick", "open"]
+    leaving = math.acos((2 + (1 + k) * v0**2 / (g * radius)) / (3 + k))
+    t_open = s["phases"]["edge"][1]["t_start"]
+    phi = np.arctan2(c["disk.x"], c["disk.y"])  # from the vertical through the table's end (0, 0)
+    assert abs(np.interp(t_open, c["t"], phi) - leaving) <= 3 * h * math.sqrt(g * math.cos(leaving) / radius)
+    after = c["t"] > t_open + 0.05
+    assert np.all(c["edge.N"][after] == 0.0) and c["disk.y"][-1] < 0.0  # falls past the table
 
 
 def test_ladder_statics_and_slide(tmp_path):

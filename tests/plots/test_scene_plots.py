@@ -181,3 +181,24 @@ def test_the_phase_bar_shares_no_colour_with_the_line_plots():
     assert len(looks) == len(MODE_STYLES)  # each state its own look
     legend = [t.get_text() for t in phases.get_legend().get_texts()]
     assert legend == ["open", "stick", "slip+", "slip−", "impact"]
+
+
+def test_segments_are_drawn_end_to_end_and_their_contact_frames_follow_the_feature(tmp_path):
+    sf = load_scene(SCENES / "ball_off_table.toml", ["simulation.t_end=0.2"])
+    run = simulate_scene(sf)
+    fig = result_figure(run)
+    paths = next(ax for ax in fig.axes if ax.get_label() == "paths")
+    drawn = [np.column_stack([line.get_xdata(), line.get_ydata()]) for line in paths.lines]
+    assert any(d.shape == (2, 2) and np.array_equal(d, [[-1.0, 0.0], [0.0, 0.0]]) for d in drawn)
+    # on the table's top: the point below the centre; past its end: the end point, normal to the centre
+    (point, normal, tangent), = contact_frames(sf.scene, np.array([-0.5, 0.1, 0.0]))
+    np.testing.assert_allclose([point, normal, tangent], [[-0.5, 0.0], [0.0, 1.0], [1.0, 0.0]], atol=ROUNDOFF)
+    (point, normal, _), = contact_frames(sf.scene, np.array([0.06, 0.08, 0.0]))
+    np.testing.assert_allclose([point, normal], [[0.0, 0.0], [0.6, 0.8]], atol=ROUNDOFF)
+    anim = build_animation(run, frames=3, dpi=40)
+    anim._func(2)
+    ax = anim._fig.axes[0]
+    assert ax.get_xlim()[0] < -1.0 and ax.get_xlim()[1] > 0.0  # the view holds the whole table
+    assert any(np.array_equal(np.column_stack([ln.get_xdata(), ln.get_ydata()]), [[-1.0, 0.0], [0.0, 0.0]])
+               for ln in ax.lines)
+    anim._draw_was_started = True  # drawn by hand: no "deleted without rendering" warning

@@ -14,7 +14,8 @@ import importlib
 
 # method name → (module, integrator class, options class, contact relations it handles)
 METHODS = {
-    "moreau-jean": ("moreau_jean", "MoreauJean", "MoreauJeanOptions", ("DiskOnLine", "DiskOnDisk")),
+    "moreau-jean": ("moreau_jean", "MoreauJean", "MoreauJeanOptions", ("DiskOnLine", "DiskOnDisk", "DiskOnSegment",
+                                                                             "SegmentEndOnEdge")),
     "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine",)),
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
 }

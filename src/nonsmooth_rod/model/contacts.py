@@ -8,17 +8,25 @@ centre of mass) to the local velocities of one contact,
 and gives the gap g (≥ 0 when separated) and the velocity-product terms Ḣ v that an
 acceleration-level (event-driven) formulation needs: g̈ = H_N · a + Ḣ_N v.
 The obstacle is a fixed straight line (horizontal or inclined), possibly moving along itself
-(a conveyor belt), or the disk of another body.
+(a conveyor belt), a fixed finite segment, or the disk of another body.
+
+The numbers come from model/contact_kernels.py, the one implementation the compiled
+Moreau–Jean loop reads too: each relation writes its geometry as a packed row (`fill_row`) and
+its `kinematics` calls the kernel of its kind with that row.
 """
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..validation import InputError, require_finite, require_index, require_nonnegative, require_point
-from .body import cross2, rotate
+from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_AY, C_OFF_BX, C_OFF_BY,
+                              C_RADIUS_A, C_RADIUS_B, C_SEGMENT_LENGTH, C_SURFACE_VELOCITY, C_TX, C_TY,
+                              C_EDGE_TX, C_EDGE_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT,
+                              KIND_SEGMENT_END_ON_EDGE, N_CONTACT_COLUMNS, kinematics_kernel)
 from .laws import ContactLaw
 
 
@@ -49,6 +57,39 @@ class Line:
         return (-math.sin(self.angle), math.cos(self.angle))
 
 
+@dataclass(frozen=True)
+class Segment:
+    """A fixed finite straight obstacle from `a` to `b` (world frame): a table top, a step.
+
+    Its tangent runs from a to b and its normal is the tangent turned by +90° (a → b along +x:
+    normal +y); a disk touches the side it is on, or an end point when it is beyond one.
+    """
+
+    a: tuple[float, float]
+    b: tuple[float, float]
+    name: str = "segment"
+
+    def __post_init__(self):
+        object.__setattr__(self, "a", require_point(f"segment {self.name!r} a", self.a))
+        object.__setattr__(self, "b", require_point(f"segment {self.name!r} b", self.b))
+        if self.length == 0.0:
+            raise InputError(f"segment {self.name!r}: a and b coincide (a segment of length 0)")
+
+    @property
+    def length(self) -> float:
+        return math.hypot(self.b[0] - self.a[0], self.b[1] - self.a[1])
+
+    @property
+    def tangent(self) -> tuple[float, float]:
+        n = self.length
+        return ((self.b[0] - self.a[0]) / n, (self.b[1] - self.a[1]) / n)
+
+    @property
+    def normal(self) -> tuple[float, float]:
+        t = self.tangent
+        return (-t[1], t[0])
+
+
 def _contact_name(name) -> str:
     if not isinstance(name, str) or not name:
         raise InputError(f"a contact name must be a non-empty string, got {name!r}")
@@ -72,8 +113,63 @@ class ContactKinematics:
     surface_velocity: float = 0.0  # subtracted from H_T v to get the slip velocity
 
 
+# Each relation's packed row, by id, beside a weak reference that tells a live relation from a
+# dead one whose id was reused. Kept out of the instances so that their __dict__ stays their
+# fields (type(c)(**c.__dict__) copies a relation).
+_PACKED_ROWS: dict = {}
+
+
+def _forget_row(ref, key) -> None:
+    entry = _PACKED_ROWS.get(key)
+    if entry is not None and entry[0] is ref:
+        del _PACKED_ROWS[key]
+
+
+class _PackedRelation:
+    """What every relation shares: its packed row (written by `fill_row`, kept until a field
+    changes) and `kinematics` from the kernel of its kind."""
+
+    _no_normal = "the contact normal is undefined"
+
+    def __setattr__(self, name, value):
+        object.__setattr__(self, name, value)
+        _PACKED_ROWS.pop(id(self), None)  # any change of geometry re-packs
+
+    def _packed_row(self):
+        entry = _PACKED_ROWS.get(id(self))
+        if entry is not None and entry[0]() is self:
+            return entry[1]
+        row = [0.0] * N_CONTACT_COLUMNS  # a list: the kernel's scalar reads are cheapest there
+        kind, body_a, body_b = self.fill_row(row)
+        key = id(self)
+        ref = weakref.ref(self, lambda r, key=key: _forget_row(r, key))
+        _PACKED_ROWS[key] = (ref, (kind, body_a, body_b, row))
+        return kind, body_a, body_b, row
+
+    def kinematics(self, q, v, n_dof: int) -> ContactKinematics:
+        """The kernel of this contact's kind at (q, v): arrays, or lists (Scene.kinematics hands
+        lists, converted once for all contacts: the interpreter reads Python floats fastest)."""
+        kind, body_a, body_b, row = self._packed_row()
+        q = q if isinstance(q, list) else np.asarray(q, dtype=float).tolist()
+        v = v if isinstance(v, list) else np.asarray(v, dtype=float).tolist()
+        hn, ht = [0.0] * 6, [0.0] * 6
+        gap, drift_n, drift_t = kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht)
+        if math.isnan(gap):
+            raise InputError(f"{self.name}: {self._no_normal}")
+        H_N, H_T = np.zeros(n_dof), np.zeros(n_dof)
+        for side, body in enumerate((body_a, body_b)):
+            for d in range(3 if body >= 0 else 0):  # element by element: cheaper than a slice
+                H_N[3 * body + d], H_T[3 * body + d] = hn[3 * side + d], ht[3 * side + d]
+        return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, row[C_SURFACE_VELOCITY])
+
+
+def _fill_disk_a(row, offset, radius) -> None:
+    row[C_OFF_AX], row[C_OFF_AY] = offset
+    row[C_RADIUS_A] = radius
+
+
 @dataclass
-class DiskOnLine:
+class DiskOnLine(_PackedRelation):
     """A disk (ball) of radius `radius` fixed on `body` touching a fixed Line.
 
     `offset` is the disk centre in the body frame, relative to the centre of mass; a radius of
@@ -99,23 +195,14 @@ class DiskOnLine:
     def bodies(self) -> tuple[int, ...]:
         return (self.body,)
 
-    def kinematics(self, q: np.ndarray, v: np.ndarray, n_dof: int) -> ContactKinematics:
-        i = 3 * self.body
-        x, y, th = q[i], q[i + 1], q[i + 2]
-        om = v[i + 2]
-        d = rotate(th, self.offset)
-        n = self.line.normal
-        t = self.line.tangent
-        rho = (d[0] - self.radius * n[0], d[1] - self.radius * n[1])
-        gap = n[0] * (x + d[0] - self.line.point[0]) + n[1] * (y + d[1] - self.line.point[1]) - self.radius
-        H_N = np.zeros(n_dof)
-        H_T = np.zeros(n_dof)
-        H_N[i : i + 3] = (n[0], n[1], cross2(rho, n))
-        H_T[i : i + 3] = (t[0], t[1], cross2(rho, t))
-        # d/dt (ρ × n) = −θ̇ (d · n): the lever arm turns with the body, the line does not.
-        drift_N = -om * om * (d[0] * n[0] + d[1] * n[1])
-        drift_T = -om * om * (d[0] * t[0] + d[1] * t[1])
-        return ContactKinematics(gap, H_N, H_T, drift_N, drift_T, self.line.velocity)
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the geometry into a packed row; returns (kind, body a, body b)."""
+        _fill_disk_a(row, self.offset, self.radius)
+        row[C_LINE_PX], row[C_LINE_PY] = self.line.point
+        row[C_NX], row[C_NY] = self.line.normal
+        row[C_TX], row[C_TY] = self.line.tangent
+        row[C_SURFACE_VELOCITY] = self.line.velocity
+        return KIND_DISK_ON_LINE, self.body, -1
 
 
 def PointOnLine(body: int, offset, line: Line | None = None, law: ContactLaw | None = None, name="corner"):
@@ -124,7 +211,97 @@ def PointOnLine(body: int, offset, line: Line | None = None, law: ContactLaw | N
 
 
 @dataclass
-class DiskOnDisk:
+class DiskOnSegment(_PackedRelation):
+    """A disk of radius `radius` fixed on `body` (centre `offset`, body frame) touching a fixed
+    Segment: its interior (normal: the segment's normal on the disk's side) or its end point
+    nearest the disk (normal: from the end point to the disk centre), whichever is nearest —
+    the two meet continuously. Beyond an end by more than the radius, the contact is open.
+    A radius of zero makes it a body point (a corner)."""
+
+    body: int
+    offset: tuple[float, float]
+    segment: Segment
+    radius: float = 0.0
+    law: ContactLaw = field(default_factory=ContactLaw)
+    name: str = "contact"
+
+    _no_normal = "the disk centre is on the segment's end point, the contact normal is undefined"
+
+    def __post_init__(self):
+        self.name = _contact_name(self.name)
+        self.body = require_index(f"contact {self.name!r} body", self.body)
+        self.offset = require_point(f"contact {self.name!r} offset", self.offset)
+        self.radius = require_nonnegative(f"contact {self.name!r} radius", self.radius)
+        _require_type(f"contact {self.name!r} segment", self.segment, Segment)
+        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return (self.body,)
+
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the geometry into a packed row; returns (kind, body a, body b)."""
+        _fill_disk_a(row, self.offset, self.radius)
+        row[C_LINE_PX], row[C_LINE_PY] = self.segment.a
+        row[C_NX], row[C_NY] = self.segment.normal
+        row[C_TX], row[C_TY] = self.segment.tangent
+        row[C_SEGMENT_LENGTH] = self.segment.length
+        return KIND_DISK_ON_SEGMENT, self.body, -1
+
+
+def PointOnSegment(body: int, offset, segment: Segment, law: ContactLaw | None = None, name="corner"):
+    """A body-fixed point (a corner) touching a segment: a disk of radius zero."""
+    return DiskOnSegment(body, tuple(offset), segment, 0.0, law or ContactLaw(), name)
+
+
+@dataclass
+class SegmentEndOnEdge(_PackedRelation):
+    """An end point (`end`: "a" or "b") of a fixed Segment against the straight edge of `body`
+    from `edge_start` to `edge_end` (body frame, the body on the edge's left: a counter-clockwise
+    outline), e.g. a table's edge under a box's bottom. Beyond the edge's ends the edge's nearest
+    end (the body's corner) touches the point; declare that corner's own contact with the
+    segment beside this one."""
+
+    body: int
+    edge_start: tuple[float, float]
+    edge_end: tuple[float, float]
+    segment: Segment
+    end: str = "b"
+    law: ContactLaw = field(default_factory=ContactLaw)
+    name: str = "edge"
+
+    _no_normal = "the segment's end point is on the body's corner, the contact normal is undefined"
+
+    def __post_init__(self):
+        self.name = _contact_name(self.name)
+        self.body = require_index(f"contact {self.name!r} body", self.body)
+        self.edge_start = require_point(f"contact {self.name!r} edge_start", self.edge_start)
+        self.edge_end = require_point(f"contact {self.name!r} edge_end", self.edge_end)
+        _require_type(f"contact {self.name!r} segment", self.segment, Segment)
+        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
+        if self.end not in ("a", "b"):
+            raise InputError(f"contact {self.name!r} end must be 'a' or 'b' (which end of the segment), "
+                             f"got {self.end!r}")
+        if self.edge_start == self.edge_end:
+            raise InputError(f"contact {self.name!r}: edge_start and edge_end coincide (an edge of length 0)")
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return (self.body,)
+
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the geometry into a packed row; returns (kind, body a, body b)."""
+        _fill_disk_a(row, self.edge_start, 0.0)
+        row[C_LINE_PX], row[C_LINE_PY] = self.segment.a if self.end == "a" else self.segment.b
+        length = math.hypot(self.edge_end[0] - self.edge_start[0], self.edge_end[1] - self.edge_start[1])
+        row[C_EDGE_TX] = (self.edge_end[0] - self.edge_start[0]) / length
+        row[C_EDGE_TY] = (self.edge_end[1] - self.edge_start[1]) / length
+        row[C_SEGMENT_LENGTH] = length
+        return KIND_SEGMENT_END_ON_EDGE, self.body, -1
+
+
+@dataclass
+class DiskOnDisk(_PackedRelation):
     """Disk `offset_a`/`radius_a` of body a against disk `offset_b`/`radius_b` of body b.
 
     The normal points from b's disk centre to a's; the tangent is the normal turned by −90°.
@@ -138,6 +315,8 @@ class DiskOnDisk:
     offset_b: tuple[float, float] = (0.0, 0.0)
     law: ContactLaw = field(default_factory=ContactLaw)
     name: str = "disk-disk"
+
+    _no_normal = "disk centres coincide, the contact normal is undefined"
 
     def __post_init__(self):
         self.name = _contact_name(self.name)
@@ -156,34 +335,9 @@ class DiskOnDisk:
     def bodies(self) -> tuple[int, ...]:
         return (self.body_a, self.body_b)
 
-    def kinematics(self, q: np.ndarray, v: np.ndarray, n_dof: int) -> ContactKinematics:
-        ia, ib = 3 * self.body_a, 3 * self.body_b
-        da = rotate(q[ia + 2], self.offset_a)
-        db = rotate(q[ib + 2], self.offset_b)
-        ca = (q[ia] + da[0], q[ia + 1] + da[1])
-        cb = (q[ib] + db[0], q[ib + 1] + db[1])
-        dx, dy = ca[0] - cb[0], ca[1] - cb[1]
-        dist = math.hypot(dx, dy)
-        if dist == 0.0:
-            raise InputError(f"{self.name}: disk centres coincide, the contact normal is undefined")
-        n = (dx / dist, dy / dist)
-        t = (n[1], -n[0])
-        gap = dist - self.radius_a - self.radius_b
-        rho_a = (da[0] - self.radius_a * n[0], da[1] - self.radius_a * n[1])
-        rho_b = (db[0] + self.radius_b * n[0], db[1] + self.radius_b * n[1])
-        H_N = np.zeros(n_dof)
-        H_T = np.zeros(n_dof)
-        H_N[ia : ia + 3] += (n[0], n[1], cross2(rho_a, n))
-        H_N[ib : ib + 3] -= (n[0], n[1], cross2(rho_b, n))
-        H_T[ia : ia + 3] += (t[0], t[1], cross2(rho_a, t))
-        H_T[ib : ib + 3] -= (t[0], t[1], cross2(rho_b, t))
-        # g̈ = H_N a + Ḣ_N v: the centres' centripetal accelerations along n, plus the turn of
-        # n itself, ṅ·w = |w_⊥|²/dist for the relative velocity w of the centres. (Moreau–Jean
-        # uses it for its activation margin and impact-time root; the event-driven integrator
-        # takes no disk–disk contacts, so the tangential term is left at zero.)
-        om_a, om_b = v[ia + 2], v[ib + 2]
-        w = (v[ia] - om_a * da[1] - v[ib] + om_b * db[1], v[ia + 1] + om_a * da[0] - v[ib + 1] - om_b * db[0])
-        w_n = w[0] * n[0] + w[1] * n[1]
-        drift_N = (-om_a * om_a * (da[0] * n[0] + da[1] * n[1]) + om_b * om_b * (db[0] * n[0] + db[1] * n[1])
-                   + (w[0] * w[0] + w[1] * w[1] - w_n * w_n) / dist)
-        return ContactKinematics(gap, H_N, H_T, drift_N, 0.0, 0.0)
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the geometry into a packed row; returns (kind, body a, body b)."""
+        _fill_disk_a(row, self.offset_a, self.radius_a)
+        row[C_OFF_BX], row[C_OFF_BY] = self.offset_b
+        row[C_RADIUS_B] = self.radius_b
+        return KIND_DISK_ON_DISK, self.body_a, self.body_b

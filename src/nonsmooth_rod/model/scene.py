@@ -58,7 +58,7 @@ class Scene:
         seen = set()
         for contact in self.contacts:
             if not hasattr(contact, "bodies") or not hasattr(contact, "kinematics"):
-                raise InputError(f"scene contacts must be contact relations (DiskOnLine, PointOnLine, "
+                raise InputError(f"scene contacts must be contact relations (DiskOnLine, PointOnLine, DiskOnSegment, "
                                  f"DiskOnDisk), got {type(contact).__name__}")
             for body in contact.bodies:
                 if body >= len(self.bodies):
@@ -106,7 +106,8 @@ class Scene:
         return force
 
     def kinematics(self, q: np.ndarray, v: np.ndarray):
-        return [c.kinematics(q, v, self.n_dof) for c in self.contacts]
+        q_list, v_list = np.asarray(q, dtype=float).tolist(), np.asarray(v, dtype=float).tolist()  # once for all
+        return [c.kinematics(q_list, v_list, self.n_dof) for c in self.contacts]
 
     def kinetic_energy(self, v: np.ndarray) -> float:
         return 0.5 * float(np.dot(self.mass_diagonal * v, v))

@@ -1,4 +1,4 @@
-"""Animations of any scene: bodies (disks, balls, rectangles, rods), lines and contact forces.
+"""Animations of any scene: bodies (disks, balls, rectangles, rods), lines, segments and contact forces.
 
 How a body is drawn: from its `shape` in the scene file (disk/ball: a circle with a spoke to show
 the turn; rectangle; rod: a segment; rod-with-balls: a segment with a ball at each end, the centre
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
-from ..model.contacts import DiskOnDisk, DiskOnLine
+from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge
 from ..validation import InputError
 
 
@@ -43,8 +43,10 @@ def _contact_parts(scene, body: int) -> list:
     """(offset, radius) of every disk or point of `body` that touches something."""
     parts = []
     for c in scene.contacts:
-        if isinstance(c, DiskOnLine) and c.body == body:
+        if isinstance(c, (DiskOnLine, DiskOnSegment)) and c.body == body:
             parts.append((tuple(c.offset), c.radius))
+        elif isinstance(c, SegmentEndOnEdge) and c.body == body:
+            parts += [(tuple(c.edge_start), 0.0), (tuple(c.edge_end), 0.0)]
         elif isinstance(c, DiskOnDisk):
             if c.body_a == body:
                 parts.append((tuple(c.offset_a), c.radius_a))
@@ -107,6 +109,9 @@ def scene_extent(result, sf) -> tuple[float, float, float, float]:
     for line in sf.lines.values():
         xs.append(line.point[0])
         ys.append(line.point[1])
+    for segment in getattr(sf, "segments", {}).values():
+        xs += [segment.a[0], segment.b[0]]
+        ys += [segment.a[1], segment.b[1]]
     x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
     pad = 0.1 * max(x1 - x0, y1 - y0, 1e-3)
     x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
@@ -133,6 +138,15 @@ def draw_lines(ax, sf, extent=None) -> None:
         below = 0.008 * (max(extent[1] - extent[0], extent[3] - extent[2]) if extent else length)
         hatch = np.array([ends[0] - below * n, ends[1] - below * n])
         ax.plot(hatch[:, 0], hatch[:, 1], color="0.7", lw=4, zorder=0)
+    draw_segments(ax, sf)
+
+
+def draw_segments(ax, sf) -> None:
+    """Each segment of the scene from end to end, its ends marked (a segment has two sides)."""
+    for segment in getattr(sf, "segments", {}).values():
+        ends = np.array([segment.a, segment.b])
+        ax.plot(ends[:, 0], ends[:, 1], color="0.3", lw=2.5, solid_capstyle="butt", zorder=1)
+        ax.plot(ends[:, 0], ends[:, 1], "o", color="0.3", ms=3, zorder=1)
 
 
 def _make_artists(ax, sf) -> list:
@@ -170,6 +184,14 @@ def contact_frames(scene, q: np.ndarray) -> list[tuple]:
             d = ca - cb
             n = d / max(np.linalg.norm(d), 1e-300)
             out.append((ca - c.radius_a * n, n, np.array([n[1], -n[0]])))
+        elif isinstance(c, (DiskOnSegment, SegmentEndOnEdge)):  # the touched feature's normal: from the kinematics
+            j = 3 * c.body
+            k = c.kinematics(q, np.zeros_like(q), q.size)
+            n, t = k.H_N[j : j + 2], k.H_T[j : j + 2]
+            if isinstance(c, SegmentEndOnEdge):  # at the segment's end point
+                out.append((np.array(c.segment.a if c.end == "a" else c.segment.b), n, t))
+            else:
+                out.append((_world(q, j, c.offset) - c.radius * n, n, t))
         else:
             centre = _world(q, 3 * c.body, c.offset)
             n, t = np.array(c.line.normal), np.array(c.line.tangent)

@@ -1,0 +1,184 @@
+"""The one implementation of contact kinematics: one kernel per kind of contact.
+
+A contact is a row of floats (its geometry, the columns C_* below) plus its kind and the (at
+most two) bodies it touches. `kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht)`
+returns (gap, Ḣ_N v, Ḣ_T v) and fills hn, ht: the Jacobian rows H_N, H_T restricted to the
+bodies, six entries, (ẋ, ẏ, θ̇) of body a then of body b (zero when the obstacle is fixed).
+
+Both users read these kernels: the compiled Moreau–Jean loop (through
+`packing.contact_kinematics`, on the packed table, where numba compiles them in) and the
+relation classes of model/contacts.py (their `kinematics`, used by the event-driven reference,
+the phase location, the impacts' reports, ...), which call them as plain Python with their own
+row (`_jit.jitable`: never a compile wait) — one source, so the two cannot drift apart.
+
+Conventions: the normal n points from the obstacle (or body b) to the disk of body a; the
+tangent is n turned by −90°, t = (n_y, −n_x) (a floor with normal +y has tangent +x);
+the drifts are d/dt of H·v along q̇ = v at fixed v, so that g̈ = H_N a + Ḣ_N v.
+"""
+from __future__ import annotations
+
+import math
+
+from .._jit import jitable
+
+KIND_DISK_ON_LINE, KIND_DISK_ON_DISK, KIND_DISK_ON_SEGMENT, KIND_SEGMENT_END_ON_EDGE = 0, 1, 2, 3
+# Float columns of a contact row. A segment stores its end a in C_LINE_P*, its unit direction
+# a → b in C_T*, its left normal in C_N* and its length in C_SEGMENT_LENGTH. A segment's end on
+# a body's edge: the end point in C_LINE_P*, the edge's start in C_OFF_A*, its unit direction
+# (body frame) in C_EDGE_T* and its length in C_SEGMENT_LENGTH.
+(C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_OFF_BX, C_OFF_BY, C_RADIUS_B, C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_TX,
+ C_TY, C_SURFACE_VELOCITY, C_MU_S, C_MU_D, C_RESTITUTION, C_SEGMENT_LENGTH, C_EDGE_TX, C_EDGE_TY) = range(19)
+N_CONTACT_COLUMNS = 19
+
+
+@jitable
+def _body_point(row, body, q, ox_col, oy_col):
+    """The disk centre's offset d from the body's centre of mass, world frame."""
+    j = 3 * body
+    c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
+    ox, oy = row[ox_col], row[oy_col]
+    return c * ox - s * oy, s * ox + c * oy
+
+
+@jitable
+def _fill_rows(hn, ht, side, nx, ny, rho_x, rho_y, sign):
+    """One body's (ẋ, ẏ, θ̇) entries of H_N and H_T for lever arm ρ to the contact point."""
+    k = 3 * side
+    tx, ty = ny, -nx
+    hn[k], hn[k + 1], hn[k + 2] = sign * nx, sign * ny, sign * (rho_x * ny - rho_y * nx)
+    ht[k], ht[k + 1], ht[k + 2] = sign * tx, sign * ty, sign * (rho_x * ty - rho_y * tx)
+
+
+@jitable
+def _clear_side(hn, ht, side):
+    for d in range(3 * side, 3 * side + 3):
+        hn[d] = 0.0
+        ht[d] = 0.0
+
+
+@jitable
+def _on_fixed_normal(row, body, q, v, hn, ht, nx, ny, px, py):
+    """A disk of body a against a fixed plane through p with normal n (a line, a segment's
+    interior): (gap, Ḣ_N v, Ḣ_T v). The lever arm turns with the body, the plane does not."""
+    j = 3 * body
+    dx, dy = _body_point(row, body, q, C_OFF_AX, C_OFF_AY)
+    r = row[C_RADIUS_A]
+    _fill_rows(hn, ht, 0, nx, ny, dx - r * nx, dy - r * ny, 1.0)
+    _clear_side(hn, ht, 1)
+    om = v[j + 2]
+    gap = nx * (q[j] + dx - px) + ny * (q[j + 1] + dy - py) - r
+    return gap, -om * om * (dx * nx + dy * ny), -om * om * (dx * ny - dy * nx)
+
+
+@jitable
+def _centre_velocity(body, dx, dy, v):
+    j = 3 * body
+    om = v[j + 2]
+    return v[j] - om * dy, v[j + 1] + om * dx
+
+
+@jitable
+def _disk_on_disk(row, body_a, body_b, q, v, hn, ht):
+    ia, ib = 3 * body_a, 3 * body_b
+    dax, day = _body_point(row, body_a, q, C_OFF_AX, C_OFF_AY)
+    dbx, dby = _body_point(row, body_b, q, C_OFF_BX, C_OFF_BY)
+    ex, ey = q[ia] + dax - q[ib] - dbx, q[ia + 1] + day - q[ib + 1] - dby
+    dist = math.sqrt(ex * ex + ey * ey)
+    if dist == 0.0:  # coincident centres: no normal; the caller reports it
+        return math.nan, math.nan, math.nan
+    nx, ny = ex / dist, ey / dist
+    ra, rb = row[C_RADIUS_A], row[C_RADIUS_B]
+    _fill_rows(hn, ht, 0, nx, ny, dax - ra * nx, day - ra * ny, 1.0)
+    _fill_rows(hn, ht, 1, nx, ny, dbx + rb * nx, dby + rb * ny, -1.0)
+    wax, way = _centre_velocity(body_a, dax, day, v)
+    wbx, wby = _centre_velocity(body_b, dbx, dby, v)
+    om_a, om_b = v[ia + 2], v[ib + 2]
+    # The centres' centripetal accelerations, plus the turn of n (and t) with the relative
+    # velocity w of the centres: ṅ = (w·t) t / dist, ṫ = −(w·t) n / dist.
+    acc_x = -om_a * om_a * dax + om_b * om_b * dbx
+    acc_y = -om_a * om_a * day + om_b * om_b * dby
+    drift_n, drift_t = _turning_drifts(wax - wbx, way - wby, nx, ny, dist, acc_x, acc_y)
+    return dist - ra - rb, drift_n, drift_t
+
+
+@jitable
+def _turning_drifts(wx, wy, nx, ny, dist, acc_x, acc_y):
+    """(Ḣ_N v, Ḣ_T v) of a normal along the centres' line (length dist, relative velocity w)."""
+    w_n, w_t = wx * nx + wy * ny, wx * ny - wy * nx
+    return acc_x * nx + acc_y * ny + w_t * w_t / dist, acc_x * ny - acc_y * nx - w_t * w_n / dist
+
+
+@jitable
+def _disk_on_segment(row, body, q, v, hn, ht):
+    """A disk against the feature of a fixed segment nearest its centre: the interior (the
+    segment's normal on the disk's side) or an end point (normal from the end to the centre)."""
+    j = 3 * body
+    dx, dy = _body_point(row, body, q, C_OFF_AX, C_OFF_AY)
+    ax, ay, ex, ey = row[C_LINE_PX], row[C_LINE_PY], row[C_TX], row[C_TY]
+    cx, cy = q[j] + dx - ax, q[j + 1] + dy - ay
+    along = cx * ex + cy * ey
+    if 0.0 <= along <= row[C_SEGMENT_LENGTH]:
+        nx, ny = row[C_NX], row[C_NY]
+        if cx * nx + cy * ny < 0.0:  # the disk is on the other side
+            nx, ny = -nx, -ny
+        return _on_fixed_normal(row, body, q, v, hn, ht, nx, ny, ax, ay)
+    end = min(max(along, 0.0), row[C_SEGMENT_LENGTH])
+    return _on_fixed_point(body, dx, dy, row[C_RADIUS_A], ax + end * ex, ay + end * ey, q, v, hn, ht)
+
+
+@jitable
+def _on_fixed_point(body, dx, dy, r, px, py, q, v, hn, ht):
+    """A disk of radius r centred at offset d (world frame) from body a's centre of mass against
+    the fixed point p: the normal from p to the centre."""
+    j = 3 * body
+    rx, ry = q[j] + dx - px, q[j + 1] + dy - py
+    dist = math.sqrt(rx * rx + ry * ry)
+    if dist == 0.0:
+        return math.nan, math.nan, math.nan
+    nx, ny = rx / dist, ry / dist
+    _fill_rows(hn, ht, 0, nx, ny, dx - r * nx, dy - r * ny, 1.0)
+    _clear_side(hn, ht, 1)
+    wx, wy = _centre_velocity(body, dx, dy, v)
+    om = v[j + 2]
+    drift_n, drift_t = _turning_drifts(wx, wy, nx, ny, dist, -om * om * dx, -om * om * dy)
+    return dist - r, drift_n, drift_t
+
+
+@jitable
+def _segment_end_on_edge(row, body, q, v, hn, ht):
+    """A segment's end point p against an edge of body a (start e, unit direction τ, body frame;
+    the body on its left, so its outward normal is τ turned by −90°). While p lies along the
+    edge, the normal is the edge's inward normal and the touching material point is the one at p;
+    beyond the edge's ends, the edge's end point nearest p touches it (the body's corner)."""
+    j = 3 * body
+    c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
+    ex, ey = _body_point(row, body, q, C_OFF_AX, C_OFF_AY)
+    tx, ty = c * row[C_EDGE_TX] - s * row[C_EDGE_TY], s * row[C_EDGE_TX] + c * row[C_EDGE_TY]
+    px, py = row[C_LINE_PX], row[C_LINE_PY]
+    along = (px - q[j] - ex) * tx + (py - q[j + 1] - ey) * ty
+    if not 0.0 <= along <= row[C_SEGMENT_LENGTH]:
+        end = min(max(along, 0.0), row[C_SEGMENT_LENGTH])
+        return _on_fixed_point(body, ex + end * tx, ey + end * ty, 0.0, px, py, q, v, hn, ht)
+    nx, ny = -ty, tx  # inward: from the obstacle's point into the body
+    rho_x, rho_y = px - q[j], py - q[j + 1]
+    _fill_rows(hn, ht, 0, nx, ny, rho_x, rho_y, 1.0)
+    _clear_side(hn, ht, 1)
+    # The edge turns with the body and the touching material point changes as the body moves:
+    # d/dt (n·v + ω ρ×n) = 2 ω n×v + ω² ρ·n, likewise for t.
+    om, vx, vy = v[j + 2], v[j], v[j + 1]
+    gap = -(nx * (px - q[j] - ex) + ny * (py - q[j + 1] - ey))
+    return (gap, 2.0 * om * (nx * vy - ny * vx) + om * om * (rho_x * nx + rho_y * ny),
+            2.0 * om * (ny * vy + nx * vx) + om * om * (rho_x * ny - rho_y * nx))
+
+
+@jitable
+def kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht):
+    """(gap, Ḣ_N v, Ḣ_T v) of one contact; fills its 6-entry Jacobian rows hn, ht. A nan gap:
+    the normal is undefined (coincident centres)."""
+    if kind == KIND_DISK_ON_LINE:
+        return _on_fixed_normal(row, body_a, q, v, hn, ht, row[C_NX], row[C_NY], row[C_LINE_PX], row[C_LINE_PY])
+    if kind == KIND_DISK_ON_SEGMENT:
+        return _disk_on_segment(row, body_a, q, v, hn, ht)
+    if kind == KIND_SEGMENT_END_ON_EDGE:
+        return _segment_end_on_edge(row, body_a, q, v, hn, ht)
+    return _disk_on_disk(row, body_a, body_b, q, v, hn, ht)

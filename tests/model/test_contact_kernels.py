@@ -1,0 +1,228 @@
+"""The one contact-kinematics implementation checked against geometry and calculus: for every kind
+of contact, on random states, the gap is the distance the geometry gives, H_N·v is the time
+derivative of the gap, H_T·v the slip velocity of the touching material points, and the drifts
+Ḣ_N v, Ḣ_T v the derivatives of H_N·v, H_T·v along q̇ = v (central finite differences,
+tolerances relative to the quantities' scale). The compiled loop's packed kernel and the
+relation's `kinematics` agree to round-off."""
+import math
+
+import numpy as np
+import pytest
+
+from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
+from nonsmooth_rod.model.packing import contact_kinematics, pack_contacts
+from nonsmooth_rod.validation import InputError
+
+EPS = 1e-6  # finite-difference step (s); the central difference errs by ~EPS² × third derivative
+
+
+def _rotate(theta, p):
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
+
+
+def _material_velocity(q, v, body, world_point):
+    """Velocity of the material point of `body` at `world_point` (finite difference of its motion)."""
+    j = 3 * body
+    local = _rotate(-q[j + 2], world_point - q[j : j + 2])
+    position = [q[j : j + 2] + s * EPS * v[j : j + 2] + _rotate(q[j + 2] + s * EPS * v[j + 2], local) for s in (1, -1)]
+    return (position[0] - position[1]) / (2 * EPS)
+
+
+def _centre(q, body, offset):
+    return q[3 * body : 3 * body + 2] + _rotate(q[3 * body + 2], offset)
+
+
+def _closest_on_segment(seg, c):
+    a, b = np.array(seg.a), np.array(seg.b)
+    s = np.clip(np.dot(c - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+    return a + s * (b - a)
+
+
+def _contact_points(c, q):
+    """(normal, point on body a, point on the other side or None) from plain geometry."""
+    if isinstance(c, DiskOnLine):
+        n = np.array(c.line.normal)
+        centre = _centre(q, c.body, c.offset)
+        return n, centre - c.radius * n, None
+    if isinstance(c, DiskOnSegment):
+        centre = _centre(q, c.body, c.offset)
+        r = centre - _closest_on_segment(c.segment, centre)
+        n = r / np.linalg.norm(r)
+        return n, centre - c.radius * n, None
+    ca, cb = _centre(q, c.body_a, c.offset_a), _centre(q, c.body_b, c.offset_b)
+    n = (ca - cb) / np.linalg.norm(ca - cb)
+    return n, ca - c.radius_a * n, cb + c.radius_b * n
+
+
+def _geometric_gap(c, q):
+    n, pa, pb = _contact_points(c, q)
+    if isinstance(c, DiskOnLine):
+        return float(np.dot(n, pa - np.array(c.line.point)))
+    if isinstance(c, DiskOnSegment):
+        return float(np.dot(n, pa - _closest_on_segment(c.segment, pa + c.radius * n)))
+    return float(np.dot(n, pa - pb))
+
+
+def _slip(c, q, v):
+    n, pa, pb = _contact_points(c, q)
+    t = np.array([n[1], -n[0]])
+    body_a = c.body_a if isinstance(c, DiskOnDisk) else c.body
+    rel = _material_velocity(q, v, body_a, pa)
+    if pb is not None:
+        rel = rel - _material_velocity(q, v, c.body_b, pb)
+    return float(np.dot(t, rel))
+
+
+def _random_state(rng, n_bodies, place):
+    q = rng.uniform(-1, 1, 3 * n_bodies)
+    v = rng.uniform(-2, 2, 3 * n_bodies)
+    place(q)
+    return q, v
+
+
+SEG = Segment((-0.4, 0.1), (0.6, 0.5), name="table")
+
+
+def _put_disk_beside_segment(where):
+    """Move body 0 so that its disk (offset (0.1, −0.05)) is over the interior or beyond an end."""
+    def place(q):
+        a, b = np.array(SEG.a), np.array(SEG.b)
+        along = {"interior": 0.3, "beyond-a": -0.25, "beyond-b": 1.3}[where] * (b - a)
+        side = 1.0 if where != "interior" or q[1] > 0 else -1.0  # both sides of the interior
+        centre = a + along + side * 0.3 * np.array(SEG.normal)
+        q[0:2] = centre - _rotate(q[2], (0.1, -0.05))
+    return place
+
+
+CASES = [
+    ("line", DiskOnLine(0, (0.2, -0.1), Line((0.1, -0.2), 0.3, velocity=0.7), 0.05), 1, lambda q: None),
+    ("point on line", DiskOnLine(0, (-0.3, 0.1), Line((0.0, 0.0), -0.4), 0.0), 1, lambda q: None),
+    ("disk on disk", DiskOnDisk(0, 1, 0.1, 0.2, (0.1, 0.05), (-0.1, 0.2)), 2, lambda q: None),
+    ("segment interior", DiskOnSegment(0, (0.1, -0.05), SEG, 0.08), 1, _put_disk_beside_segment("interior")),
+    ("segment end a", DiskOnSegment(0, (0.1, -0.05), SEG, 0.08), 1, _put_disk_beside_segment("beyond-a")),
+    ("segment end b", DiskOnSegment(0, (0.1, -0.05), SEG, 0.0), 1, _put_disk_beside_segment("beyond-b")),
+]
+
+
+def _along(c, q, v, s):
+    return c.kinematics(q + s * EPS * v, v, q.size)
+
+
+@pytest.mark.parametrize("label, contact, n_bodies, place", CASES, ids=[c[0] for c in CASES])
+def test_kinematics_are_the_derivatives_of_the_geometry(label, contact, n_bodies, place):
+    rng = np.random.default_rng(22)
+    for _ in range(20):
+        q, v = _random_state(rng, n_bodies, place)
+        k = contact.kinematics(q, v, q.size)
+        plus, minus = _along(contact, q, v, 1), _along(contact, q, v, -1)
+        scale = 1.0 + np.abs(v).max() ** 2  # lengths ~1 m, speeds ~2 m/s
+        assert k.gap == pytest.approx(_geometric_gap(contact, q), abs=1e-12)
+        assert k.H_N @ v == pytest.approx((plus.gap - minus.gap) / (2 * EPS), rel=1e-7, abs=1e-7 * scale)
+        assert k.H_T @ v - k.surface_velocity == pytest.approx(
+            _slip(contact, q, v) - k.surface_velocity, rel=1e-7, abs=1e-7 * scale)
+        assert k.drift_N == pytest.approx((plus.H_N @ v - minus.H_N @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+        assert k.drift_T == pytest.approx((plus.H_T @ v - minus.H_T @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+
+
+@pytest.mark.parametrize("label, contact, n_bodies, place", CASES, ids=[c[0] for c in CASES])
+def test_the_packed_kernel_of_the_loop_is_the_relations(label, contact, n_bodies, place):
+    table, index = pack_contacts([contact], n_bodies)
+    rng = np.random.default_rng(23)
+    for _ in range(5):
+        q, v = _random_state(rng, n_bodies, place)
+        k = contact.kinematics(q, v, q.size)
+        hn, ht = np.zeros(6), np.zeros(6)
+        gap, drift = contact_kinematics(table, index, 0, q, v, hn, ht)
+        rows = np.zeros((2, q.size))
+        for side, body in enumerate(index[0, 1:]):
+            if body >= 0:
+                rows[:, 3 * body : 3 * body + 3] = hn[3 * side : 3 * side + 3], ht[3 * side : 3 * side + 3]
+        np.testing.assert_allclose([gap, drift], [k.gap, k.drift_N], rtol=1e-13, atol=1e-14)
+        np.testing.assert_allclose(rows, [k.H_N, k.H_T], rtol=1e-13, atol=1e-14)
+
+
+def test_segment_contact_switches_feature_continuously():
+    """Across the end of the segment the interior and the end point give the same gap and rows."""
+    c = DiskOnSegment(0, (0.0, 0.0), Segment((0.0, 0.0), (1.0, 0.0)), 0.1)
+    v = np.array([0.3, -0.2, 0.5])
+    inside, outside = (c.kinematics(np.array([1.0 + s, 0.25, 0.0]), v, 3) for s in (-1e-12, 1e-12))
+    assert inside.gap == pytest.approx(outside.gap, abs=1e-11)
+    np.testing.assert_allclose(inside.H_N, outside.H_N, atol=1e-11)
+    np.testing.assert_allclose(inside.H_T, outside.H_T, atol=1e-11)
+
+
+def test_segment_contact_opens_beyond_the_end_by_more_than_the_radius():
+    seg = Segment((-1.0, 0.0), (0.0, 0.0))
+    c = DiskOnSegment(0, (0.0, 0.0), seg, 0.1)
+    level = np.array([0.1 + 1e-6, 0.0, 0.0])  # at the segment's level, just beyond reach of its end
+    assert c.kinematics(level, np.zeros(3), 3).gap > 0
+    below = np.array([0.15, -0.5, 0.0])  # beyond the end and below: the end point is nearest, far away
+    assert c.kinematics(below, np.zeros(3), 3).gap == pytest.approx(math.hypot(0.15, 0.5) - 0.1)
+
+
+def test_bad_segments_and_undefined_normals_are_one_line_errors():
+    with pytest.raises(InputError, match="segment 'step'.*length 0"):
+        Segment((1.0, 2.0), (1.0, 2.0), name="step")
+    with pytest.raises(InputError, match="segment 'step' b"):
+        Segment((1.0, 2.0), (math.nan, 2.0), name="step")
+    c = DiskOnSegment(0, (0.0, 0.0), Segment((0.0, 0.0), (1.0, 0.0)), 0.1, name="ball")
+    on_end = c.kinematics(np.array([1.0, 0.0, 0.0]), np.zeros(3), 3)  # the interior's normal holds there
+    assert on_end.gap == -0.1 and tuple(on_end.H_N) == (0.0, 1.0, 0.0)
+    d = DiskOnDisk(0, 1, 0.1, 0.1, name="pair")
+    with pytest.raises(InputError, match="pair: disk centres coincide"):
+        d.kinematics(np.zeros(6), np.zeros(6), 6)
+    with pytest.raises(InputError, match="contact 'ball' segment must be a Segment"):
+        DiskOnSegment(0, (0.0, 0.0), Line(), 0.1, name="ball")
+
+
+def test_a_changed_field_is_repacked():
+    c = DiskOnLine(0, (0.0, 0.0), Line(), 0.1)
+    q = np.array([0.0, 1.0, 0.0])
+    assert c.kinematics(q, np.zeros(3), 3).gap == pytest.approx(0.9)
+    c.radius = 0.3
+    assert c.kinematics(q, np.zeros(3), 3).gap == pytest.approx(0.7)
+
+
+BOX_EDGE = ((-0.1, -0.05), (0.1, -0.05))  # the bottom of a 0.2 × 0.1 box, counter-clockwise
+
+
+def _put_edge_over_segment_end(where):
+    """Move body 0 so that the segment's end b lies along its bottom edge, or beyond an end of it."""
+    def place(q):
+        fraction = {"along": 0.3, "beyond-start": -0.4, "beyond-end": 1.5}[where]
+        start, end = np.array(BOX_EDGE[0]), np.array(BOX_EDGE[1])
+        point_on_edge = _rotate(q[2], start + fraction * (end - start))
+        outward = _rotate(q[2], (0.0, -1.0))
+        q[0:2] = np.array(SEG.b) - point_on_edge - 0.02 * outward  # the end point 2 cm outside
+    return place
+
+
+EDGE_CASES = [(f"end on edge {w}", SegmentEndOnEdge(0, *BOX_EDGE, SEG, "b"), 1, _put_edge_over_segment_end(w))
+              for w in ("along", "beyond-start", "beyond-end")]
+
+
+@pytest.mark.parametrize("label, contact, n_bodies, place", EDGE_CASES, ids=[c[0] for c in EDGE_CASES])
+def test_segment_end_on_an_edge_is_the_derivatives_of_its_geometry(label, contact, n_bodies, place):
+    rng = np.random.default_rng(24)
+    for _ in range(20):
+        q, v = _random_state(rng, n_bodies, place)
+        k = contact.kinematics(q, v, q.size)
+        plus, minus = _along(contact, q, v, 1), _along(contact, q, v, -1)
+        scale = 1.0 + np.abs(v).max() ** 2
+        p = np.array(SEG.b)
+        start, end = (q[0:2] + _rotate(q[2], e) for e in BOX_EDGE)
+        s = np.clip(np.dot(p - start, end - start) / np.dot(end - start, end - start), 0.0, 1.0)
+        assert k.gap == pytest.approx(np.linalg.norm(p - (start + s * (end - start))), abs=1e-12)  # 2 cm or the corner's
+        n = k.H_N[:2]
+        touching = p if label.endswith("along") else start + s * (end - start)
+        t = np.array([n[1], -n[0]])
+        assert k.H_T @ v == pytest.approx(np.dot(t, _material_velocity(q, v, 0, touching)), rel=1e-7, abs=1e-7 * scale)
+        assert k.H_N @ v == pytest.approx((plus.gap - minus.gap) / (2 * EPS), rel=1e-7, abs=1e-7 * scale)
+        assert k.drift_N == pytest.approx((plus.H_N @ v - minus.H_N @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+        assert k.drift_T == pytest.approx((plus.H_T @ v - minus.H_T @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+    table, index = pack_contacts([contact], n_bodies)
+    hn, ht = np.zeros(6), np.zeros(6)
+    gap, drift = contact_kinematics(table, index, 0, q, v, hn, ht)
+    np.testing.assert_allclose([gap, drift, *hn[:3], *ht[:3]], [k.gap, k.drift_N, *k.H_N, *k.H_T], rtol=1e-13,
+                               atol=1e-14)
