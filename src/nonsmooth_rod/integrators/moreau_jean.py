@@ -129,9 +129,10 @@ class MoreauJean:
 
     @staticmethod
     def samples_estimate(options, duration: float, save_every: float | None) -> float:
-        """How many samples a run keeps (the driver's memory check)."""
+        """How many samples a run keeps (the driver's memory check), counting the window of
+        per-step rows it runs in (a row costs about what a sample does)."""
         steps = duration / options.h
-        return (steps if save_every is None else min(steps, duration / save_every)) + 2
+        return (steps if save_every is None else min(steps, duration / save_every)) + 2 + min(steps, MAX_CHUNK)
 
     def run(self, scene: Scene, q0, v0, t_end: float, *, t0: float = 0.0, resume: ResumeState | None = None,
             save_every: float | None = None, stop=()) -> SimulationResult:
