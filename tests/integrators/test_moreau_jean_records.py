@@ -133,3 +133,15 @@ def test_a_stop_condition_ends_the_run_where_it_first_holds_without_running_on()
                         t0=stopped.t[-1], resume=stopped.end_state)
     reference = nr.simulate(scene, q0, v0, 2.5, h=h, save_every=0.1)
     np.testing.assert_array_equal(again.q[-1], reference.q[-1])
+
+
+@pytest.mark.parametrize("make", [belt, rod])
+def test_small_windows_give_the_very_same_run(make, monkeypatch):
+    from nonsmooth_rod.integrators import moreau_jean
+
+    scene, q0, v0, t_end = make()
+    whole = nr.simulate(scene, q0, v0, t_end, h=1e-3)
+    monkeypatch.setattr(moreau_jean, "MAX_CHUNK", 7)  # windows of 7 steps: slides between phase boundaries
+    windows = nr.simulate(scene, q0, v0, t_end, h=1e-3)
+    assert_same_continuation(whole, windows, 0.0)
+    assert len(whole.events) >= 2

@@ -206,7 +206,8 @@ class Collector:
         self.codes = np.zeros((n, n_contacts), dtype=np.int8)
         self.n = 0
         self.runs: list[list[tuple[int, int]]] = [[] for _ in range(n_contacts)]  # (first step, code)
-        self.rows: dict[int, tuple] = {}  # step → (q, v, p_normal, p_tangent, states) around changes
+        self._blocks: list[tuple] = []  # (steps, q, v, p_normal, p_tangent, states, records valid) around changes
+        self._index = None
         self.impact_rows: list[tuple] = []  # (step, contact, t, q_k, v_k, v_k+1, p_n, p_t)
         self._codes_before = None
 
@@ -252,17 +253,40 @@ class Collector:
             return
         before = codes[:1] - 1 if self._codes_before is None else self._codes_before[None, :]
         changed = np.vstack([before, codes[:-1]]) != codes
-        for i in range(codes.shape[1]):
-            for m in np.flatnonzero(changed[:, i]):
+        rows_changed = np.flatnonzero(changed.any(axis=1))
+        for m in rows_changed:  # few: a contact's state changes at its phase boundaries
+            for i in np.flatnonzero(changed[m]):
                 self.runs[i].append((window.k_base + r_lo + int(m), int(codes[m, i])))
-        steps = window.k_base + r_lo + np.flatnonzero(changed.any(axis=1))
-        need = np.unique((steps[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
-        for j in need[(need >= window.k_base) & (need <= k_to)]:
-            r = j - window.k_base
-            records = (out[2][r].copy(), out[3][r].copy(), out[5][r].copy()) if j < k_to else (None, None, None)
-            if j not in self.rows or records[0] is not None:
-                self.rows[int(j)] = (out[0][r].copy(), out[1][r].copy(), *records)
+        if rows_changed.size:
+            self._keep_rows(window, window.k_base + r_lo + rows_changed, k_to)
         self._codes_before = codes[-1].copy()
+
+    def _keep_rows(self, window: Window, steps: np.ndarray, k_to: int) -> None:
+        """The rows of steps k − HISTORY … k for each state change at step k, as arrays (a
+        contact that chatters changes every step: its rows cost what the per-step records did)."""
+        out = window.out
+        need = np.unique((steps[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
+        need = need[(need >= window.k_base) & (need <= k_to)]
+        r = need - window.k_base
+        rec = np.minimum(r, out[2].shape[0] - 1)
+        self._blocks.append((need, out[0][r], out[1][r], out[2][rec], out[3][rec], out[5][rec], need < k_to))
+        self._index = None
+
+    def _row(self, j):
+        """(q, v, p_normal, p_tangent, states) of global step j (records None if not kept), or None."""
+        if self._index is None:
+            blocks = list(zip(*self._blocks)) if self._blocks else [np.zeros(0, dtype=np.int64)] + [np.zeros(0)] * 6
+            steps, *arrays = (np.concatenate(b) for b in blocks)
+            # a step kept twice (the last of one window, again in the next): its later copy has its records
+            order = np.lexsort((arrays[-1], steps))
+            last = np.r_[steps[order][1:] != steps[order][:-1], True]
+            self._index = (steps[order][last], *(a[order][last] for a in arrays))
+        steps = self._index[0]
+        m = int(np.searchsorted(steps, j))
+        if m == steps.size or steps[m] != j:
+            return None
+        q, v, pn, pt, st, valid = (a[m] for a in self._index[1:])
+        return (q, v, pn, pt, st) if valid else (q, v, None, None, None)
 
     def _impacts(self, window: Window) -> None:
         out = window.out
@@ -279,17 +303,17 @@ class Collector:
 
     # What located_phases reads, by global step (NaN / −1 where the run has no such row).
     def p_normal(self, j, i):
-        row = self.rows.get(j)
+        row = self._row(j)
         return math.nan if row is None or row[2] is None else float(row[2][i])
 
     def p_tangent(self, j, i):
-        row = self.rows.get(j)
+        row = self._row(j)
         return math.nan if row is None or row[3] is None else float(row[3][i])
 
     def state(self, j, i):
-        row = self.rows.get(j)
+        row = self._row(j)
         return -1 if row is None or row[4] is None else int(row[4][i])
 
     def qv(self, j):
-        row = self.rows.get(j)
+        row = self._row(j)
         return None if row is None else (row[0], row[1])
