@@ -2,18 +2,18 @@
 
     python benchmarks/bench_memory.py [--quick] [--stop] [--steps 1e6 1e7]
 
-Each case runs in a fresh process (the bouncing ball, h = 1e-4 s): the library (`nr.simulate`,
-with and without `save_every`) and the CLI (`nonsmooth-rod run`, which also writes the CSV). It
-prints the samples kept, the estimate (`integrators.check_output_size` of the integrator's
-`samples_estimate`: the bytes the run adds), the measured growth of the peak RSS over the
-process before the run (library: its RSS just before; CLI: the peak of the same command run for
-a few steps), and their ratio. `--stop`: CPU of a run whose stop condition holds at 5 % of
+The bouncing ball (e = 0.8, h = 1e-4 s), through the library (`nr.simulate`, with and without
+`save_every`, in this process) and the CLI (`nonsmooth-rod run`, which also writes the CSV, in a
+fresh process). It prints the samples kept, the estimate (`integrators.check_output_size` of the
+integrator's `samples_estimate`: the bytes the run adds), the measured growth of the peak RSS
+over the process before the run (library: VmHWM reset just before the run; CLI: over the peak
+of the same command run for 200 steps), and their ratio. Linux only (/proc). `--stop`: CPU of a run whose stop condition holds at 5 % of
 t_end against the whole run's.
 """
 from __future__ import annotations
 
 import argparse
-import json
+import gc
 import os
 import subprocess
 import sys
@@ -24,26 +24,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 H = 1e-4
 
-LIBRARY = r"""
-import json, resource, sys
-import nonsmooth_rod as nr
-from nonsmooth_rod import toys
-from nonsmooth_rod.integrators import check_output_size
-from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
-steps, save_every, h = int(sys.argv[1]), (None if sys.argv[2] == "none" else float(sys.argv[2])), float(sys.argv[3])
-ball = toys.BouncingBall(restitution=0.8)
-scene, (q0, v0) = ball.scene(), ball.initial_state()
-nr.simulate(scene, q0, v0, 200 * h, h=h)  # loads the compiled loop
-def rss():
-    with open("/proc/self/statm") as fh:
-        return int(fh.read().split()[1]) * 4096
-before = rss()
-estimate = check_output_size(MoreauJean.samples_estimate(MoreauJeanOptions(h=h), steps * h, save_every), scene)
-result = nr.simulate(scene, q0, v0, steps * h, h=h, save_every=save_every)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-print(json.dumps({"before": before, "peak": peak, "estimate": estimate, "samples": len(result.t),
-                  "status": str(result.status)}))
-"""
+def _status_kb(field: str) -> int:
+    with open("/proc/self/status") as fh:
+        return next(int(line.split()[1]) for line in fh if line.startswith(field + ":")) * 1024
 
 
 def _env():
@@ -52,12 +35,31 @@ def _env():
     return env
 
 
+def _ball():
+    from nonsmooth_rod import toys
+
+    ball = toys.BouncingBall(restitution=0.8)
+    return ball.scene(), *ball.initial_state()
+
+
 def library_case(steps: int, save_every) -> dict:
-    out = subprocess.run([sys.executable, "-c", LIBRARY, str(steps), str(save_every or "none"), str(H)],
-                         capture_output=True, text=True, env=_env(), check=True)
-    d = json.loads(out.stdout.strip().splitlines()[-1])
-    return {"interface": "library", "steps": steps, "save_every": save_every, "samples": d["samples"],
-            "estimate": d["estimate"], "growth": d["peak"] - d["before"]}
+    """In this process: the peak RSS (VmHWM, reset just before through /proc/self/clear_refs)
+    over the RSS before the run."""
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.integrators import check_output_size
+    from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
+
+    scene, q0, v0 = _ball()
+    nr.simulate(scene, q0, v0, 200 * H, h=H)  # loads the compiled loop
+    gc.collect()
+    with open("/proc/self/clear_refs", "w") as fh:
+        fh.write("5")  # resets VmHWM to the current RSS
+    before = _status_kb("VmRSS")
+    estimate = check_output_size(MoreauJean.samples_estimate(MoreauJeanOptions(h=H), steps * H, save_every), scene)
+    result = nr.simulate(scene, q0, v0, steps * H, h=H, save_every=save_every)
+    growth = _status_kb("VmHWM") - before
+    return {"interface": "library", "steps": steps, "save_every": save_every, "samples": len(result.t),
+            "estimate": estimate, "growth": growth}
 
 
 def _cli_peak(steps: int, folder: str) -> int:
@@ -89,10 +91,8 @@ def cli_case(steps: int) -> dict:
 def stop_cost(steps: int) -> tuple[float, float]:
     """CPU seconds of the whole run and of the same run stopped by a condition at 5 % of t_end."""
     import nonsmooth_rod as nr
-    from nonsmooth_rod import toys
 
-    ball = toys.BouncingBall(restitution=0.8)
-    scene, (q0, v0) = ball.scene(), ball.initial_state()
+    scene, q0, v0 = _ball()
     t_end = steps * H
     nr.simulate(scene, q0, v0, 200 * H, h=H)
     full = nr.simulate(scene, q0, v0, t_end, h=H).cpu_time_s

@@ -36,6 +36,9 @@ from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
 
+# A window row with the temporaries of collecting from it, in samples (bench_memory.py: 11.4 MB
+# measured against 6.9 MB for one sample a row, ball, 65 536-step windows).
+WINDOW_SAMPLES = 1.7
 STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
 # Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
 # 0 means the kernel's own default (solvers/kernels.py).
@@ -130,9 +133,11 @@ class MoreauJean:
     @staticmethod
     def samples_estimate(options, duration: float, save_every: float | None) -> float:
         """How many samples a run keeps (the driver's memory check), counting the window of
-        per-step rows it runs in (a row costs about what a sample does)."""
+        per-step rows it runs in and the temporaries of taking samples from it (measured:
+        WINDOW_SAMPLES samples' worth a row, benchmarks/bench_memory.py)."""
         steps = duration / options.h
-        return (steps if save_every is None else min(steps, duration / save_every)) + 2 + min(steps, MAX_CHUNK)
+        kept = steps if save_every is None else min(steps, duration / save_every)
+        return kept + 2 + WINDOW_SAMPLES * min(steps, MAX_CHUNK)
 
     def run(self, scene: Scene, q0, v0, t_end: float, *, t0: float = 0.0, resume: ResumeState | None = None,
             save_every: float | None = None, stop=()) -> SimulationResult:
@@ -145,6 +150,8 @@ class MoreauJean:
         q0, v0 = require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
         if resume is not None:
             _check_resume(resume, scene.n_dof, len(names))
+            if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
+                raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
         grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
         model, work = _model_and_work(packed, resume)
@@ -169,8 +176,8 @@ class MoreauJean:
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         solver_options = dict(opts.solver_options)
         params = np.zeros(loop.N_PARAMS)
-        params[[loop.P_H, loop.P_THETA, loop.P_GAMMA, loop.P_T0, loop.P_RTOL]] = \
-            opts.h, opts.theta, opts.activation_gamma, grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
+        params[loop.P_H], params[loop.P_THETA], params[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
+        params[loop.P_T0], params[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
         iparams = np.array([-1 if solver_code is None else solver_code,
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
                             names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1],

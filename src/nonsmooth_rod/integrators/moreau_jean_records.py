@@ -116,6 +116,8 @@ class Grid:
 
     def time(self, k: np.ndarray | int):
         """Times of global step indices (the last one: t_end exactly)."""
+        if isinstance(k, (int, np.integer)):
+            return self.t_end if k == self.last else self.origin + float(k) * self.h
         t = self.origin + np.asarray(k, dtype=float) * self.h
         return np.where(np.asarray(k) == self.last, self.t_end, t)
 
