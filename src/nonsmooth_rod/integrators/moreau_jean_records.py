@@ -189,8 +189,8 @@ def count_kept(grid: Grid, save_every: float | None) -> int:
     if save_every is None:
         return grid.n_steps + 1
     total, k = 0, grid.first
-    while k <= grid.last:  # in blocks: no array of every step
-        hi = min(grid.last, k + MAX_CHUNK * 16)
+    while k <= grid.last:  # in blocks of a window's size: no array of every step
+        hi = min(grid.last, k + MAX_CHUNK)
         total += kept_steps(grid, k, hi, save_every).size
         k = hi + 1
     return total
