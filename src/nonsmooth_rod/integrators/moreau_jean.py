@@ -36,9 +36,9 @@ from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
 
-# A window row with the temporaries of collecting from it, in samples (bench_memory.py: 11.4 MB
-# measured against 6.9 MB for one sample a row, ball, 65 536-step windows).
-WINDOW_SAMPLES = 1.7
+# A window row with the temporaries of collecting from it, in samples (bench_memory.py, ball,
+# 65 536-step windows, save_every = 0.1 s: 8.1 MB measured for 1e6 and 1e7 steps).
+WINDOW_SAMPLES = 1.1
 STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
 # Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
 # 0 means the kernel's own default (solvers/kernels.py).
