@@ -16,13 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _jit
-from .integrators import METHODS, integrator_classes, supported_contacts
+from .integrators import METHODS, MAX_OUTPUT_BYTES, check_output_size, integrator_classes, supported_contacts
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
 from .validation import InputError, quoted, require_finite, require_positive, require_state
 
-# Refuse a run whose saved output would exceed this (bytes), before allocating anything.
-MAX_OUTPUT_BYTES = 4 * 2**30
 # A max_step asking scipy for more steps than this is refused (about a minute of stepping).
 MAX_CAPPED_STEPS = 10**6
 
@@ -34,17 +32,32 @@ class StopAtImpact:
     contact: str
 
 
+@dataclass(frozen=True)
+class RunSetup:
+    """What a result was run with (`result.setup`): what `result.restart` runs again."""
+
+    scene: Scene
+    method: str
+    options: dict
+    stop: object
+    save_every: float | None
+
+
 def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *, t0: float = 0.0,
-             save_every: float | None = None, stop=None, **options) -> SimulationResult:
-    """Simulate `scene` from (q0, v0) at time t0 to t_end with the named method.
+             save_every: float | None = None, stop=None, resume=None, **options) -> SimulationResult:
+    """Simulate `scene` from (q0, v0) at time t0 to exactly t_end with the named method.
 
     method: "moreau-jean" (options h, theta, solver, solver_options, activation_gamma,
     min_phase, fast), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...) or "regularized"
     (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping, time_limit, ...).
-    save_every: keep one sample per this many seconds (default: every step / output_dt).
+    save_every: keep one sample per this many seconds (default: every step / output_dt);
+    Moreau–Jean thins while it runs, so memory follows what is kept.
     stop: a contact name or `StopAtImpact(name)` (the run ends at that contact's first
     impact), a callable (t, q, v) -> bool (the run ends at the first saved sample where it is
-    true, status "stopped"), or a list of these.
+    true, status "stopped"; Moreau–Jean tries it while it runs), or a list of these.
+    resume: the `end_state` of an earlier Moreau–Jean result (what its next step reads: contact
+    memory, warm starts, the step grid): the run goes on exactly as the earlier one would have;
+    `result.restart(t_end)` passes it.
     Bad input raises InputError naming the argument; a run that fails returns a result with
     status "failed" and a message saying where and why.
     """
@@ -56,25 +69,38 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     t_end = require_finite("t_end", t_end)
     if t_end <= t0:
         raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
+    if save_every is not None:
+        save_every = require_positive("save_every", save_every)
     integrator_cls, options_cls = _method(method, scene)
     impact_stops, callables = _stop_conditions(stop, scene)
     opts = _options(options_cls, method, options, impact_stops)
     _check_step_cap(opts, t_end - t0)
-    _check_output_size(method, opts, scene, t_end - t0, save_every)
-    run_scene = _shifted(scene, t0)
+    check_output_size(integrator_cls.samples_estimate(opts, t_end - t0, save_every), scene,
+                      integrator_cls.SAMPLES_KNOB)
     if getattr(opts, "fast", False):  # a run that would be compiled: say once if numba is missing
         _jit.warn_once_without_numba()
-    result = integrator_cls(opts).run(run_scene, q0, v0, t_end - t0)
+    result = _run(integrator_cls(opts), scene, q0, v0, t0, t_end, save_every, callables, resume)
     result.method = method
+    result.setup = RunSetup(scene, method, dict(options), stop, save_every)
     # What the run was asked for, by the caller's names: saved results describe it (result_files).
     result.run_inputs = {"scene": scene, "q0": q0, "v0": v0, "t0": t0, "t_end": t_end,
                          "options": dict(options), "save_every": save_every, "stop": stop}
+    return result
+
+
+def _run(integrator, scene, q0, v0, t0, t_end, save_every, callables, resume) -> SimulationResult:
+    """The integrator's run: on the scene's own clock with the stops and thinning inside the run
+    where it can (Moreau–Jean); otherwise from 0 on a shifted scene, stops and thinning after."""
+    if getattr(integrator, "absolute_time", False):
+        return integrator.run(scene, q0, v0, t_end, t0=t0, resume=resume, save_every=save_every, stop=callables)
+    result = integrator.run(_shifted(scene, t0), q0, v0, t_end - t0)
     if t0:
         _shift_times(result, t0)
     if callables:
         _apply_stop(result, callables)
     if save_every is not None:
-        _decimate(result, require_positive("save_every", save_every))
+        _decimate(result, save_every)
+    result.end_state = None  # restarted from (q, v): these methods decide their modes afresh
     return result
 
 
@@ -131,19 +157,6 @@ def _check_step_cap(opts, duration: float) -> None:
     if duration / cap > MAX_CAPPED_STEPS:
         raise InputError(f"max_step = {cap:g} s over a run of {duration:g} s asks for more than "
                          f"{MAX_CAPPED_STEPS:.0e} ODE steps: use max_step ≥ {duration / MAX_CAPPED_STEPS:.3g} s")
-
-
-def _check_output_size(method: str, opts, scene: Scene, duration: float, save_every) -> None:
-    """Refuse, before allocating, a run whose samples cannot fit in memory."""
-    if method == "moreau-jean":
-        samples, knob = duration / opts.h, "a larger h or a shorter t_end"
-    else:
-        samples, knob = duration / opts.output_dt, "a coarser output_dt or a shorter t_end"
-    per_sample = 8 * (3 * scene.n_dof + 3 * len(scene.contacts)) + 8
-    needed = samples * per_sample
-    if not math.isfinite(needed) or needed > MAX_OUTPUT_BYTES:
-        raise InputError(f"the run would keep {samples:.3g} samples ({needed / 2**30:.3g} GiB), over the "
-                         f"{MAX_OUTPUT_BYTES / 2**30:g} GiB limit: use {knob}")
 
 
 def _shifted(scene: Scene, t0: float) -> Scene:
@@ -230,4 +243,4 @@ def _decimate(result: SimulationResult, save_every: float) -> None:
                                    tr.tangential_force[keep], tr.modes[keep])
 
 
-__all__ = ["simulate", "StopAtImpact", "MAX_OUTPUT_BYTES"]
+__all__ = ["simulate", "StopAtImpact", "RunSetup", "MAX_OUTPUT_BYTES"]

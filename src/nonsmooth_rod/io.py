@@ -10,7 +10,6 @@ from __future__ import annotations
 import contextlib
 import csv
 import hashlib
-import io
 import json
 import math
 import os
@@ -142,15 +141,21 @@ def write_json(path, data) -> None:
 
 def write_csv(path, columns: dict, order=None) -> None:
     """Columns of equal length; floats in their shortest round-trip form (0.05, not
-    0.050000000000000003): reading the file back gives the very same float64."""
+    0.050000000000000003): reading the file back gives the very same float64. Written in blocks
+    of rows straight to the (atomic) file: its text never sits in memory whole."""
     order = list(order or columns.keys())
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(order)
     cols = [columns[name] for name in order]
-    for row in zip(*cols):
-        writer.writerow([repr(float(x)) if isinstance(x, (float, np.floating)) else x for x in row])
-    write_text(path, buf.getvalue())
+    n = len(cols[0]) if cols else 0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(order)
+        for lo in range(0, n, _CSV_BLOCK):
+            block = [c[lo: lo + _CSV_BLOCK] for c in cols]
+            writer.writerows([repr(float(x)) if isinstance(x, (float, np.floating)) else x for x in row]
+                             for row in zip(*block))
+
+
+_CSV_BLOCK = 10_000  # rows per block written
 
 
 def read_csv(path) -> dict:

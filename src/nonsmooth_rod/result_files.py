@@ -3,7 +3,8 @@
     save(result, "out/")        # trajectory.csv, summary.json (schema nonsmooth-rod/summary/2), scene copy
     result = load("out/")       # the same SimulationResult back (floats bit for bit), scene_file attached
     df = to_dataframe(result)   # pandas (optional extra): one tidy column per quantity
-    again = restart("out/", t=0.5, t_end=1.0)   # continue from the saved state at t
+    again = restart("out/", t_end=2.0)          # go on exactly from the saved end state
+    again = restart("out/", t=0.5, t_end=1.0)   # or from (q, v) of the last sample at or before t
 
 Column names are `<body>.<quantity>` and `<contact>.<quantity>` (docs/output-format.md). A result
 made by `scenefile.simulate_scene` carries `result.scene_file`, which gives the names; otherwise
@@ -193,7 +194,15 @@ def summary_dict(result, command=None) -> dict:
         "events": [{"t": float(e.t), "kind": e.kind, "contact": e.contact, "detail": e.detail} for e in result.events],
         "steps": int(getattr(result, "steps", 0)), "cpu_time_s": float(getattr(result, "cpu_time_s", 0.0)),
         "stats": dict(result.stats), "provenance": provenance(command),
+        "end_state": _end_state_dict(result),
     }
+
+
+def _end_state_dict(result):
+    """What the run's next step would read (result.end_state), for an exact restart; None when the
+    method keeps nothing beyond (q, v) or the run failed."""
+    state = getattr(result, "end_state", None)
+    return None if state is None else state.as_dict()
 
 
 def scene_copy_name(sf) -> str:
@@ -339,9 +348,21 @@ def load(folder):
         impacts=[_impact_from(d, bodies, contacts) for d in summary["impacts"]],
         phases={c: [Phase(p["mode"], p["t_start"], p["t_end"]) for p in summary["phases"][c]] for c in contacts},
         steps=summary["steps"], cpu_time_s=summary["cpu_time_s"], stats=summary["stats"])
+    result.end_state = _end_state_from(summary.get("end_state"), len(bodies) * 3, len(contacts), folder)
     copies = [folder / n for n in ("scene.toml", "scene.json") if (folder / n).exists()]
     result.scene_file = load_scene(copies[0], summary["scene"].get("overrides", ())) if copies else None
     return result
+
+
+def _end_state_from(d, n_dof: int, n_contacts: int, folder):
+    if d is None:
+        return None
+    from .integrators.moreau_jean_records import ResumeState
+
+    try:
+        return ResumeState.from_dict(d, n_dof, n_contacts)
+    except (KeyError, TypeError, ValueError) as err:
+        raise InputError(f"{folder / 'summary.json'}: end_state: cannot read it ({err})") from None
 
 
 def to_dataframe(result):
@@ -353,23 +374,43 @@ def to_dataframe(result):
     return pd.DataFrame(trajectory_columns(result))
 
 
-def restart(source, t: float, t_end: float | None = None):
-    """Run on from the saved state at the last sample at or before `t` (a results folder or a
-    result with its scene_file), up to `t_end` (default: the scene file's t_end), same settings."""
-    from .scenefile import run_method
+def restart(source, t: float | None = None, t_end: float | None = None):
+    """Run on from a result (a results folder, a loaded result or one made by `nr.simulate`) up to
+    `t_end` (default: the scene file's t_end), with the same scene, method and settings.
 
+    Without `t` (or with t at or after the last sample) it goes on from the end state the run
+    saved — for Moreau–Jean with the contact memory and the step grid, so run(0→T) and
+    run(0→T/2) then restart(T/2→T) agree bit for bit; from an earlier `t`, from the state (q, v)
+    of the last sample at or before t."""
     result = load(source) if isinstance(source, (str, Path)) else source
-    sf = getattr(result, "scene_file", None)
-    if sf is None:
-        raise InputError("restart needs the scene: a results folder with its scene copy, or a scene-file run")
+    scene, method, options, stop, save_every = _setup_of(result)
     times = np.asarray(result.trajectory.t)
-    k = int(np.searchsorted(times, t, side="right")) - 1
+    k = len(times) - 1 if t is None else int(np.searchsorted(times, t, side="right")) - 1
     if k < 0:
         raise InputError(f"restart time t = {t!r} precedes the saved run (starts at {times[0]:g} s)")
+    sf = getattr(result, "scene_file", None)
+    if t_end is None and sf is None:
+        raise InputError("restart needs t_end (the result has no scene file to take it from)")
     t0, t_end = float(times[k]), float(sf.t_end if t_end is None else t_end)
     if t_end <= t0:
         raise InputError(f"t_end = {t_end:g} s must exceed the restart time {t0:g} s")
     q0, v0 = result.trajectory.q[k].copy(), result.trajectory.v[k].copy()
-    again = run_method(sf.scene, q0, v0, t_end, sf.method, sf.options, sf.stop, t0=t0)
+    resume = getattr(result, "end_state", None) if k == len(times) - 1 else None
+    from .driver import simulate
+
+    again = simulate(scene, q0, v0, t_end, method, t0=t0, save_every=save_every, stop=stop, resume=resume,
+                     **options)
     again.scene_file = sf
     return again
+
+
+def _setup_of(result):
+    """(scene, method, options, stop, save_every) a result was run with."""
+    setup = getattr(result, "setup", None)
+    if setup is not None:
+        return setup.scene, setup.method, setup.options, setup.stop, setup.save_every
+    sf = getattr(result, "scene_file", None)
+    if sf is None:
+        raise InputError("restart needs the scene: a results folder with its scene copy, a scene-file run or "
+                         "a result of nr.simulate")
+    return sf.scene, sf.method, dict(sf.options), list(sf.stop) or None, None

@@ -140,6 +140,9 @@ class SimulationResult:
     `tangential_force` and `modes` are the saved samples (also in `trajectory`); `phases` maps
     each contact name to its maximal constant-state intervals; `impacts` and `events` are
     located in time; `stats` counts the work (steps, solves, whether the loop was compiled).
+    `end_state` is what the run's next step would read (Moreau–Jean: contact memory, warm starts,
+    the step grid; None for methods that restart from (q, v) alone) and `setup` what the run was
+    made with (`nr.simulate` sets it): `restart` goes on from them.
     """
 
     method: str
@@ -153,6 +156,8 @@ class SimulationResult:
     steps: int = 0
     cpu_time_s: float = 0.0
     stats: dict = field(default_factory=dict)
+    end_state: object = None
+    setup: object = None
 
     def __post_init__(self):
         self.status = Status(self.status)

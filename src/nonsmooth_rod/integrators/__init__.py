@@ -11,6 +11,13 @@ relations each handles, which the driver checks once before a run.
 from __future__ import annotations
 
 import importlib
+import math
+
+from ..validation import InputError
+
+# The one memory limit of every method: a run whose kept samples would need more than this
+# (bytes, check_output_size's estimate) is refused before it allocates anything.
+MAX_OUTPUT_BYTES = 4 * 2**30
 
 # method name → (module, integrator class, options class, contact relations it handles)
 METHODS = {
@@ -33,4 +40,22 @@ def integrator_classes(method: str):
     return getattr(module, cls_name), getattr(module, options_name)
 
 
-__all__ = ["METHODS", "integrator_classes", "supported_contacts"]
+def sample_bytes(n_dof: int, n_contacts: int) -> int:
+    """Bytes one kept sample holds in a result: t; q, v, a (n_dof floats each); N, T (floats)
+    and the mode (a reference to a shared word, plus its one-byte code while it is built)."""
+    return 8 + 24 * n_dof + 25 * n_contacts
+
+
+def check_output_size(samples: float, scene, knob: str = "save_every or a shorter t_end") -> float:
+    """Refuse a run whose `samples` kept samples cannot fit the limit; returns the bytes they need.
+    Each integrator's `samples_estimate(options, duration, save_every)` says how many it keeps,
+    its `SAMPLES_KNOB` what lowers it."""
+    needed = samples * sample_bytes(scene.n_dof, len(scene.contacts))
+    if not math.isfinite(needed) or needed > MAX_OUTPUT_BYTES:
+        raise InputError(f"the run would keep {samples:.3g} samples ({needed / 2**30:.3g} GiB), over the "
+                         f"{MAX_OUTPUT_BYTES / 2**30:g} GiB limit: use {knob}")
+    return needed
+
+
+__all__ = ["METHODS", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes", "sample_bytes",
+           "supported_contacts"]

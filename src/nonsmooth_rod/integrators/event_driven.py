@@ -48,7 +48,6 @@ from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
-from ..solvers import available_solvers
 from ..validation import (
     Choice,
     InputError,
@@ -60,6 +59,8 @@ from ..validation import (
     require_positive,
     require_state,
 )
+from ..solvers import available_solvers
+from . import check_output_size
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
@@ -67,7 +68,6 @@ RTOL_FLOOR = 100 * float(np.finfo(float).eps)
 # An absolute tolerance on positions (m) and velocities (m/s) beyond this is no tolerance: the
 # solver's steps then skip over the events (atol = 1e20 wrote −inf into the trajectory).
 ATOL_CEILING = 1e-2
-MAX_OUTPUT_BYTES = 2**31  # the trajectory a run may hold in memory (2 GiB)
 
 
 @dataclass
@@ -374,6 +374,13 @@ class EventDriven:
 
     name = "event-driven"
 
+    SAMPLES_KNOB = "a coarser output_dt or a shorter t_end"  # what keeps fewer samples (the driver's memory refusal says it)
+
+    @staticmethod
+    def samples_estimate(options, duration: float, save_every: float | None) -> float:
+        """How many samples a run keeps (every output_dt; the driver thins to save_every after)."""
+        return duration / options.output_dt + 2
+
     def __init__(self, options: EventDrivenOptions | None = None):
         self.options = options or EventDrivenOptions()
 
@@ -473,12 +480,7 @@ class EventDriven:
             if not (isinstance(c.body, (int, np.integer)) and 0 <= c.body < len(scene.bodies)):
                 raise InputError(f"contact {c.name}: body must be an index below {len(scene.bodies)}, "
                                  f"got {c.body!r}")
-        n_samples = t_end / self.options.output_dt
-        per_sample = 8 * (1 + 3 * scene.n_dof + 3 * len(scene.contacts))  # t, q, v, a, N, T, mode refs
-        if n_samples * per_sample > MAX_OUTPUT_BYTES:
-            raise InputError(f"output_dt = {self.options.output_dt!r} s over t_end = {t_end!r} s asks for "
-                             f"{n_samples:.3g} samples ({n_samples * per_sample / 2**30:.3g} GiB); use "
-                             f"output_dt ≥ {t_end * per_sample / MAX_OUTPUT_BYTES:.3g} s")
+        check_output_size(self.samples_estimate(self.options, t_end, None), scene, self.SAMPLES_KNOB)
         return require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
 
     def _loop(self, scene, run, modes, t_end, names):

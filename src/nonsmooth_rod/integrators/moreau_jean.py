@@ -35,7 +35,12 @@ from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_c
 from ..validation import Choice, Flag, InputError, Number, Text, check_options, option, require_positive, require_state
 from . import moreau_jean_loop as loop
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
+from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
+                                 ResumeState, Window, kept_steps)
 
+# A window row with the temporaries of collecting from it, in samples (bench_memory.py, ball,
+# 65 536-step windows, save_every = 0.1 s: 8.1 MB measured for 1e6 and 1e7 steps).
+WINDOW_SAMPLES = 1.1
 STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
 # Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
 # 0 means the kernel's own default (solvers/kernels.py).
@@ -80,8 +85,8 @@ def loop_kernels(compiled: bool):
     return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
 
 
-def _allocate(packed, q0, v0, n_steps):
-    """The model, work and out tuples of moreau_jean_loop."""
+def _model_and_work(packed, resume: ResumeState | None):
+    """The model and work tuples of moreau_jean_loop; the contact memory from `resume`."""
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
     model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
              packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
@@ -89,15 +94,26 @@ def _allocate(packed, q0, v0, n_steps):
     work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
             np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
             np.zeros(n_dof), np.zeros(nc, dtype=np.int64))
-    q = np.empty((n_steps + 1, n_dof))
-    v = np.empty((n_steps + 1, n_dof))
-    q[0], v[0] = q0, v0
-    per_step = [np.zeros((n_steps, nc)) for _ in range(3)]
-    capacity = n_steps + 4 * nc
-    out = (q, v, *per_step, np.zeros((n_steps, nc), dtype=np.int64), np.zeros(capacity),
-           np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
-           np.zeros(loop.N_COUNTERS, dtype=np.int64))
-    return model, work, out
+    if resume is not None:
+        work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
+            resume.was_closed, resume.grazing, resume.slip_sign
+    return model, work
+
+
+def _chunk_size(grid: Grid, stopping: bool) -> int:
+    """Steps per window: the whole run up to MAX_CHUNK; with a stop condition, a 64th of the run
+    (tried between windows: a stop costs at most ~2/64 of the run past the step where it holds)."""
+    if stopping:
+        return max(64, min(MAX_CHUNK, grid.n_steps // 64))
+    return max(1, min(MAX_CHUNK, grid.n_steps))
+
+
+def _check_resume(resume, n_dof: int, nc: int) -> None:
+    if not isinstance(resume, ResumeState):
+        raise InputError(f"resume must be the end_state of a Moreau–Jean result, got {type(resume).__name__}")
+    if resume.q.shape[1:] != (n_dof,) or resume.states.shape[1:] != (nc,) or resume.q.shape[0] != \
+            resume.states.shape[0] + 1 or resume.states.shape[0] > HISTORY:
+        raise InputError("resume state does not match the scene (degrees of freedom or contacts)")
 
 
 # Steps run interpreted to measure a cold run's per-step cost before deciding whether to compile.
@@ -115,94 +131,193 @@ def compiled_part(solver: str, solver_code, callback: bool):
     return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []
 
 
+class Engine:
+    """The kernels a run's steps use: compiled, or their interpreted twins (the same source).
+
+    A cold compiled part under the default policy (_jit) runs its first PROBE_STEPS steps
+    interpreted and times them: when the rest of the run is shorter than compiling, it goes on
+    interpreted while a detached process compiles the part for later runs; otherwise it compiles
+    now (once, said with the time measured here) and goes on compiled from the step it reached.
+    """
+
+    def __init__(self, compiled: bool, part: str, what: str, job: list):
+        self.part, self.what, self.job = part, what, job
+        self.probing = compiled and not _jit.engine_is_warm(part) and _jit.compile_policy() == "auto"
+        self.kernels = loop_kernels(compiled and not self.probing)
+
+    def steps(self, n: int) -> int:
+        """How many of the n steps the next call may run (the probe's, while probing)."""
+        return min(n, PROBE_STEPS) if self.probing else n
+
+    def measured(self, steps: int, seconds: float, steps_left: int, status) -> None:
+        """After a call: decide, once the probe has run, whether the rest runs compiled."""
+        if not self.probing or steps <= 0:
+            return
+        self.probing = False
+        compile_s, _ = _jit.compile_estimate_s(self.part)
+        if seconds / steps * steps_left > compile_s and status == loop.RUN_OK:
+            self.kernels = loop
+        else:
+            _jit.compile_in_background(self.part, self.job, self.what, compile_s)
+
+    def compiling(self):
+        """The compile notice and lock around a call of the compiled kernels (nothing when warm)."""
+        return _jit.compiling(self.part, self.what) if self.kernels is loop else contextlib.nullcontext()
+
+
 class MoreauJean:
     """The Moreau–Jean one-step integrator over a Scene (one loop: moreau_jean_loop)."""
 
     name = "moreau-jean"
+    absolute_time = True  # reads the scene's clock itself (t0 + k h): the driver does not shift it
 
     def __init__(self, options: MoreauJeanOptions | None = None):
         self.options = options or MoreauJeanOptions()
 
-    def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        require_positive("t_end", t_end)
-        opts = self.options
-        n_steps = max(1, int(math.ceil(t_end / opts.h - 1e-9)))
-        names = [c.name for c in scene.contacts]
+    SAMPLES_KNOB = "a larger h, a coarser save_every or a shorter t_end"  # what keeps fewer samples (the driver's memory refusal says it)
+
+    @staticmethod
+    def samples_estimate(options, duration: float, save_every: float | None) -> float:
+        """How many samples a run keeps (the driver's memory check), counting the window of
+        per-step rows it runs in and the temporaries of taking samples from it (measured:
+        WINDOW_SAMPLES samples' worth a row, benchmarks/bench_memory.py)."""
+        steps = duration / options.h
+        kept = steps if save_every is None else min(steps, duration / save_every)
+        return kept + 2 + WINDOW_SAMPLES * min(steps, MAX_CHUNK)
+
+    def run(self, scene: Scene, q0, v0, t_end: float, *, t0: float = 0.0, resume: ResumeState | None = None,
+            save_every: float | None = None, stop=()) -> SimulationResult:
+        """From (q0, v0) at t0 (or the end state `resume` of an earlier run) to exactly t_end,
+        keeping one sample per `save_every` (default: every step); `stop`: callables (t, q, v)
+        tried at each kept sample, ending the run at the first that holds."""
+        if not t_end > t0:
+            raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
+        opts, names = self.options, [c.name for c in scene.contacts]
         q0, v0 = require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
+        if resume is not None:
+            _check_resume(resume, scene.n_dof, len(names))
+            if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
+                raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
+        grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
-        model, work, out = _allocate(packed, q0, v0, n_steps)
+        model, work = _model_and_work(packed, resume)
+        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)))
+        window.seed(q0, v0, grid.first, resume)
+        collector = Collector(grid, scene.n_dof, len(names), save_every, resume)
+        params, iparams = self._parameters(grid, names)
+        solver_code = COMPILED_SOLVERS.get(opts.solver)
+        engine = Engine(bool(opts.fast and _jit.ENABLED),
+                        *compiled_part(opts.solver, solver_code, scene.applied_force is not None))
+        self._solver_error = None
+        wall = time.process_time()
+        with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
+            ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop))
+        cpu = time.process_time() - wall
+        stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
+                 "compiled": engine.kernels is loop and solver_code is not None,
+                 "force_callback": scene.applied_force is not None}
+        return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
+
+    def _parameters(self, grid, names):
+        opts = self.options
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         solver_options = dict(opts.solver_options)
-        params = np.array([opts.h, opts.theta, opts.activation_gamma, 0.0,
-                           float(solver_options.get("tol", DEFAULT_RTOL))])
+        params = np.zeros(loop.N_PARAMS)
+        params[loop.P_H], params[loop.P_THETA], params[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
+        params[loop.P_T0], params[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
         iparams = np.array([-1 if solver_code is None else solver_code,
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
                             names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1],
                            dtype=np.int64)
-        callback = scene.applied_force is not None
-        self._solver_error = None
-        wall = time.process_time()
-        with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
-            compiled = self._run_loop(scene, n_steps, solver_code, params, iparams, model, work, out)
-        cpu = time.process_time() - wall
-        stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
-                 "compiled": compiled and solver_code is not None, "force_callback": callback}
-        return self._result(scene, packed, out, names, t_end, cpu, stats)
+        return params, iparams
 
-    def _run_loop(self, scene, n_steps, solver_code, params, iparams, model, work, out) -> bool:
-        """Steps 0 … n_steps − 1, compiled when it pays (_jit: no run waits for the compiler
-        longer than it would run without it); True if they ran compiled."""
-        compiled = bool(self.options.fast and _jit.ENABLED)
-        part, what, job = compiled_part(self.options.solver, solver_code, scene.applied_force is not None)
-        done = 0
-        if compiled and not _jit.engine_is_warm(part) and _jit.compile_policy() == "auto":
-            done, compiled = self._probe_interpreted(part, what, job, scene, n_steps, solver_code, params,
-                                                     iparams, model, work, out)
-        if done < n_steps and out[9][loop.K_STATUS] == loop.RUN_OK:
-            with _jit.compiling(part, what) if compiled else contextlib.nullcontext():
-                self._advance(loop_kernels(compiled), scene, done, n_steps, solver_code, params, iparams,
-                              model, work, out)
-        return compiled
+    def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops):
+        """Run the grid's steps window by window; returns (run status, global step the run ended at)."""
+        k, counters = grid.first, window.out[9]
+        if stops and self._stop_holds(stops, grid.time(k), window.out[0][window.r], window.out[1][window.r]):
+            collector.take(window, k, k, final=True)
+            return loop.RUN_STOPPED_BY_CONDITION, k
+        while k < grid.last:
+            if window.room() == 0:
+                window.slide()
+            last = bool(grid.h_last) and k == grid.last - 1
+            n = engine.steps(1 if last else min(window.room(), grid.first + grid.n_full - k))
+            step_params = self._shortened(params, grid, window, k) if last else params
+            params[loop.P_K0] = window.k_base
+            snapshot = ([w.copy() for w in work], counters.copy()) if stops else None
+            started = time.perf_counter()
+            status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
+            engine.measured(k_done - k, time.perf_counter() - started, grid.last - k_done, status)
+            k_hold = self._first_hold(stops, collector, window, k, k_done) if stops else None
+            if k_hold is not None:
+                if k_hold < k_done:  # replay to the step where it holds: the end state is that step's
+                    for w, saved in zip(work, snapshot[0]):
+                        w[...] = saved
+                    counters[:] = snapshot[1]
+                    window.r = k - window.k_base
+                    self._advance(engine, scene, window, k_hold - k, step_params, iparams, model, work)
+                collector.take(window, k, k_hold, final=True)
+                return loop.RUN_STOPPED_BY_CONDITION, k_hold
+            final = status != loop.RUN_OK or k_done == grid.last
+            collector.take(window, k, k_done, final=final)
+            k = k_done
+            if status != loop.RUN_OK:
+                return status, k
+        return loop.RUN_OK, k
 
-    def _probe_interpreted(self, part, what, job, scene, n_steps, solver_code, params, iparams, model, work,
-                           out):
-        """A cold compiled part: time the first steps interpreted, then (steps done, compile now?):
-        go on interpreted — compiling in the background — when the rest is shorter than compiling."""
-        probe = min(n_steps, PROBE_STEPS)
-        start = time.perf_counter()
-        self._advance(loop_kernels(False), scene, 0, probe, solver_code, params, iparams, model, work, out)
-        rest = (time.perf_counter() - start) / probe * (n_steps - probe)
-        compile_s, _ = _jit.compile_estimate_s(part)
-        if rest <= compile_s or out[9][loop.K_STATUS] != loop.RUN_OK:
-            _jit.compile_in_background(part, job, what, compile_s)
-            return probe, False
-        return probe, True
+    @staticmethod
+    def _shortened(params, grid, window, k):
+        """Parameters of the last step, shortened to end at t_end: it starts at t_k of the grid."""
+        p = params.copy()
+        p[loop.P_H], p[loop.P_T0], p[loop.P_K0] = grid.h_last, grid.origin + float(k) * grid.h, -float(k - window.k_base)
+        return p
 
-    def _advance(self, kernels, scene, k_start, k_end, solver_code, params, iparams, model, work, out):
-        """Steps k_start … k_end − 1 with the given kernels (compiled, or their interpreted twins)."""
-        if scene.applied_force is None and solver_code is not None:
-            kernels.run_steps(k_start, k_end, params, iparams, model, work, out)
-        else:
-            self._run_stepwise(kernels, scene, k_start, k_end, params, iparams, model, work, out)
+    def _advance(self, engine, scene, window, n, params, iparams, model, work):
+        """n steps from the window's current row with the engine's kernels (compiled, or their
+        interpreted twins); returns (run status, global step reached)."""
+        out, r0 = window.out, window.r
+        counters = out[9]
+        counters[loop.K_DONE] = r0
+        kernels = engine.kernels
+        with engine.compiling():
+            if scene.applied_force is None and iparams[loop.I_SOLVER] >= 0:
+                status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out)
+            else:
+                status = self._run_stepwise(kernels, scene, r0, r0 + n, params, iparams, model, work, out)
+        window.r = int(counters[loop.K_DONE])
+        return int(status), window.k_base + window.r
 
-    def _run_stepwise(self, kernels, scene, k_start, k_end, params, iparams, model, work, out):
+    @staticmethod
+    def _stop_holds(stops, t, q, v) -> bool:
+        return any(bool(cond(float(t), q.copy(), v.copy())) for cond in stops)
+
+    def _first_hold(self, stops, collector, window, k_from, k_to):
+        """The first kept step in (k_from, k_to] where a stop condition holds, or None."""
+        for k in kept_steps(collector.grid, k_from + 1, k_to, collector.save_every):
+            r = k - window.k_base
+            if k > k_from and self._stop_holds(stops, collector.grid.time(k), window.out[0][r], window.out[1][r]):
+                return int(k)
+        return None
+
+    def _run_stepwise(self, kernels, scene, r_start, r_end, params, iparams, model, work, out):
         """The loop step by step from Python: for a Python `applied_force` (called back for each
         step's force) and for the Python (QP) solvers."""
         q, v, counters = out[0], out[1], out[9]
-        h, th = params[loop.P_H], params[loop.P_THETA]
         f = np.empty(scene.n_dof)
         solver_code = int(iparams[loop.I_SOLVER])
         compiled_step = kernels.compiled_step if solver_code >= 0 else None
-        for k in range(k_start, k_end):
+        for k in range(r_start, r_end):
             kernels.step_force(k, params, model, out, f)
             if scene.applied_force is not None:
-                f += scene.applied((k + th) * h, q[k], v[k])
+                t = params[loop.P_T0] + ((params[loop.P_K0] + k) + params[loop.P_THETA]) * params[loop.P_H]
+                f += scene.applied(t, q[k], v[k])
             if compiled_step is not None:
                 status = compiled_step(k, f, params, iparams, model, work, out)
             else:
                 status = self._python_solver_step(kernels, k, f, params, iparams, model, work, out)
             if kernels.end_of_step(k, status, counters) != loop.RUN_OK:
-                break
+                return counters[loop.K_STATUS]
+        return loop.RUN_OK
 
     def _python_solver_step(self, kernels, k, f, params, iparams, model, work, out):
         """One step with a Python solver (QP backends): the loop's kernels around
@@ -230,74 +345,74 @@ class MoreauJean:
             states = np.array([STATE_CODES[s] for s in res.states], dtype=np.int64)
         return kernels.finish_step(k, params, iparams, na, p, u, states, q[k], v[k], model, work, out)
 
-    def _ending(self, out, names, t_end):
-        """(status word, message, steps done, solver-failure event or None) from the counters."""
+    def _ending(self, status, k_end, grid, window, names):
+        """(status word, message, solver-failure event or None) of how the run ended at step k_end."""
+        out = window.out
         q, states, counters = out[0], out[5], out[9]
-        h, code, k = self.options.h, int(counters[loop.K_STATUS]), int(counters[loop.K_FAIL_STEP])
-        n_done = int(counters[loop.K_DONE]) if code != loop.RUN_OK else q.shape[0] - 1
-        if code == loop.RUN_OK:
-            return "ok", f"reached t_end = {t_end:g} s", n_done, None
-        if code == loop.RUN_STOPPED:
-            return "ok", f"stopped at the impact of {self.options.stop_at_impact}", n_done, None
-        if code == loop.RUN_NONFINITE:
-            return "failed", f"non-finite state at step {k + 1}, t = {(k + 1) * h:.9g} s", n_done, None
-        if code == loop.RUN_BAD_GEOMETRY:
+        t_end = float(grid.time(k_end))
+        if status == loop.RUN_OK:
+            return "ok", f"reached t_end = {grid.t_end:g} s", None
+        if status == loop.RUN_STOPPED:
+            return "ok", f"stopped at the impact of {self.options.stop_at_impact}", None
+        if status == loop.RUN_STOPPED_BY_CONDITION:
+            return "stopped", f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
+        k = window.k_base + int(counters[loop.K_FAIL_STEP])  # the failing step
+        t_k = float(grid.origin + k * grid.h)
+        if status == loop.RUN_NONFINITE:
+            return "failed", f"non-finite state at step {k + 1}, t = {float(grid.time(k + 1)):.9g} s", None
+        if status == loop.RUN_BAD_GEOMETRY:
             name = names[int(counters[loop.K_FAIL_CONTACT])]
-            return "failed", (f"{name}: disk centres coincide at step {k}, t = {k * h:.9g} s, the contact "
-                              "normal is undefined"), n_done, None
-        state_txt = ", ".join(f"{name}:{STATE_NAMES[states[k - 1, i]] if k else 'initial'}"
+            return "failed", (f"{name}: disk centres coincide at step {k}, t = {t_k:.9g} s, the contact "
+                              "normal is undefined"), None
+        r = k - window.k_base
+        state_txt = ", ".join(f"{name}:{STATE_NAMES[states[r - 1, i]] if r else 'initial'}"
                               for i, name in enumerate(names))
-        where = f"step {k}, t = {k * h:.9g} s, contact states {state_txt}, q = {np.array2string(q[k], precision=6)}"
+        where = f"step {k}, t = {t_k:.9g} s, contact states {state_txt}, q = {np.array2string(q[r], precision=6)}"
         if self._solver_error is not None:
             message = str(self._solver_error.with_context(where))
         else:
             message = f"{self.options.solver}: {_KERNEL_FAILURES.get(int(counters[loop.K_SOLVER_STATUS]), 'failed')} ({where})"
-        return "failed", message, n_done, Event(k * h, "solver-failure", "", {"message": message})
+        return "failed", message, Event(t_k, "solver-failure", "", {"message": message})
 
-    def _impacts(self, scene, out, names, n_done):
-        q, v, p_n, p_t = out[0], out[1], out[2], out[3]
-        impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
-        h, minv = self.options.h, scene.inverse_mass_diagonal
+    def _impacts(self, scene, grid, collector, names):
+        minv = scene.inverse_mass_diagonal
         impacts, events = [], []
-        for n in range(min(int(counters[loop.K_N_IMPACTS]), impact_t.shape[0])):
-            k, i, t_hit = int(impact_step[n]), int(impact_contact[n]), float(impact_t[n])
-            if k >= n_done:
-                continue
-            f = scene.force(k * h, q[k], v[k])
-            v_hit = v[k] + (t_hit - k * h) * minv * f
-            q_hit = q[k] + (t_hit - k * h) * v[k]
-            impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v[k + 1].copy(), p_n[k].copy(), p_t[k].copy()))
+        for k, i, t_hit, q_k, v_k, v_next, p_n, p_t in collector.impact_rows:
+            t_k = float(grid.origin + k * grid.h)
+            f = scene.force(t_k, q_k, v_k)
+            v_hit = v_k + (t_hit - t_k) * minv * f
+            q_hit = q_k + (t_hit - t_k) * v_k
+            impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v_next, p_n, p_t))
             events.append(Event(t_hit, "impact", names[i], {"step": k}))
         return impacts, events
 
-    def _result(self, scene, packed, out, names, t_end, cpu, stats) -> SimulationResult:
-        h = self.options.h
-        status, message, n_done, failure = self._ending(out, names, t_end)
-        impacts, events = self._impacts(scene, out, names, n_done)
-        counters = out[9]
-        t = np.arange(n_done + 1) * h
-        q, v = out[0][: n_done + 1], out[1][: n_done + 1]
-        a = np.full_like(v, np.nan)
-        a[1:] = np.diff(v, axis=0) / h
-        N = np.zeros((n_done + 1, len(names)))
-        T = np.zeros_like(N)
-        N[1:], T[1:] = out[2][:n_done] / h, out[3][:n_done] / h
-        modes = np.empty((n_done + 1, len(names)), dtype=object)
-        modes[1:] = np.array(STATE_NAMES, dtype=object)[out[5][:n_done]]
-        modes[0] = modes[1] if n_done else "open"
+    def _result(self, scene, packed, grid, window, collector, work, ending, names, cpu, stats) -> SimulationResult:
+        run_status, k_end = ending
+        status, message, final_event = self._ending(run_status, k_end, grid, window, names)
+        impacts, events = self._impacts(scene, grid, collector, names)
+        counters = window.out[9]
+        t, q, v, a, N, T, codes = collector.trajectory_arrays()
+        modes = np.array(STATE_NAMES, dtype=object)[codes]
+        if k_end == grid.first and collector.resume is None:
+            modes[:] = "open"
         t_stop = None
-        if int(counters[loop.K_STATUS]) == loop.RUN_STOPPED:
+        if run_status == loop.RUN_STOPPED:
             t_stop = max(i.t for i in impacts if i.contact == self.options.stop_at_impact)
-        phases, phase_events = located_phases(scene, out, packed, impacts, n_done, h, self.options.min_phase,
-                                              t_stop)
-        events = sorted(events + phase_events, key=lambda e: e.t) + ([failure] if failure else [])
+        phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end,
+                                              self.options.min_phase, t_stop)
+        events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
+        n_done = k_end - grid.first
         stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
                      solver_iterations=int(counters[loop.K_ITERATIONS]),
                      inconsistent_steps=int(counters[loop.K_INCONSISTENT]),
                      solver_fallbacks=int(counters[loop.K_FALLBACKS]))
-        traj = Trajectory(t, q, v, a, N, T, modes)
-        return SimulationResult(self.name, status, message, traj, names, events, impacts, phases,
-                                steps=n_done, cpu_time_s=cpu, stats=stats)
+        result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, events,
+                                  impacts, phases, steps=n_done, cpu_time_s=cpu, stats=stats)
+        on_grid = k_end < grid.last or not grid.h_last
+        last_h = grid.h_last if k_end == grid.last and grid.h_last else (
+            collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
+        result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
+        return result
 
 
 _KERNEL_FAILURES = {1: "no valid solution of the step problem (secondary ray)",
@@ -312,7 +427,7 @@ SLIP_MODES = ("slip+", "slip-")
 
 
 def _crossing(values, level, k, h):
-    """Where the linear extrapolation of step impulses values[k−2], values[k−1] reaches `level`,
+    """Where the linear extrapolation of step impulses values(k−2), values(k−1) reaches `level`,
     as an offset from t_k; None without a usable slope.
 
     The impulse of step j that keeps a persistent contact closed answers the change of its
@@ -321,29 +436,33 @@ def _crossing(values, level, k, h):
     t_j − 0.58 h in the paper's case 3, later in case 2); we take it at the step's start t_j."""
     if k < 2:
         return None
-    slope = (values[k - 1] - values[k - 2]) / h
-    if slope == 0.0:
+    slope = (values(k - 1) - values(k - 2)) / h
+    if slope == 0.0 or math.isnan(slope):
         return None
-    return (level - values[k - 1]) / slope - h
+    return (level - values(k - 1)) / slope - h
 
 
-def _boundary_offset(before, after, k, i, out, mu_s, h, slip_velocity):
+def _boundary_offset(before, after, k, i, records, mu_s, h, slip_velocity):
     """Offset from t_k of the switch before → after of contact i at step k (None: t_k).
 
     Extrapolated from the last two steps spent in `before` (a one-step blip merged into a phase,
-    e.g. the stick step of a slip reversal, is skipped)."""
-    p_n, p_t, states = out[2][:, i], out[3][:, i], out[5][:, i]
+    e.g. the stick step of a slip reversal, is skipped). `records` gives each step's impulses
+    and state by global step index (moreau_jean_records.Collector)."""
+    code = STATE_CODES[before]
+
+    def in_before(j):  # steps j − 1 and j − 2 both in `before`
+        return records.state(j - 1, i) == code == records.state(j - 2, i)
+
     j = k  # one past the last step in `before` whose predecessor is in `before` too
-    while j >= 2 and j > k - 3 and not (STATE_NAMES[states[j - 1]] == before == STATE_NAMES[states[j - 2]]):
+    while j >= 2 and j > k - 3 and not in_before(j):
         j -= 1
-    if j < 2 or not (STATE_NAMES[states[j - 1]] == before == STATE_NAMES[states[j - 2]]):
+    if j < 2 or not in_before(j):
         return None
     shift = (j - k) * h
     if after == "open":  # the normal impulse fades to zero
-        offset = _crossing(p_n, 0.0, j, h)
+        offset = _crossing(lambda m: records.p_normal(m, i), 0.0, j, h)
     elif before == "stick":  # the friction ratio reaches μs
-        ratio = np.abs(p_t[:j]) / np.maximum(p_n[:j], 1e-300)
-        offset = _crossing(ratio, mu_s, j, h)
+        offset = _crossing(lambda m: abs(records.p_tangent(m, i)) / max(records.p_normal(m, i), 1e-300), mu_s, j, h)
     else:  # slip → stick or reversal: the slip velocity at the steps' ends reaches zero
         s1, s2 = slip_velocity(j - 1), slip_velocity(j)
         slope = (s2 - s1) / h
@@ -352,43 +471,57 @@ def _boundary_offset(before, after, k, i, out, mu_s, h, slip_velocity):
     return None if offset is None else offset + shift
 
 
-def located_phases(scene, out, packed, impacts, n_done, h, min_phase, t_stop):
+def _contact_phases(runs, grid, k_end, t_final, min_phase):
+    """The phases of one contact's runs of one state (first step, code) up to step k_end."""
+    runs = [(k, c) for k, c in runs if k < k_end]
+    starts = np.array([k for k, _ in runs], dtype=np.int64)
+    bounds = np.r_[grid.origin + starts.astype(float) * grid.h, t_final]
+    return phases_from_intervals(bounds, [STATE_NAMES[c] for _, c in runs], min_phase)
+
+
+def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_stop):
     """Per-contact phases with each boundary placed inside its step (interpolating the slip
     velocity, the friction ratio or the normal impulse between steps; an impact's boundary at the
-    impact time), and one event per boundary."""
+    impact time), and one event per boundary; from the run's start t_first on."""
     phases, events = {}, []
-    names = [c.name for c in scene.contacts]
-    if not n_done:
+    if k_end <= grid.first:
         return phases, events
-    bounds = np.arange(n_done + 1) * h
-    if t_stop is not None and n_done >= 1:
-        bounds[-1] = max(float(t_stop), bounds[-2])
-    impact_time = {(imp.contact, int(round(imp.t / h))): imp.t for imp in impacts}
-    for i, name in enumerate(names):
-        codes = out[5][:n_done, i]
-        starts = np.flatnonzero(codes[1:] != codes[:-1]) + 1  # runs of one state
-        starts = np.concatenate((np.zeros(1, dtype=starts.dtype), starts))
-        found = phases_from_intervals(np.append(bounds[starts], bounds[-1]), [STATE_NAMES[c] for c in codes[starts]],
-                                      min_phase)
+    h, t_first = grid.h, float(grid.time(grid.first))
+    t_final = float(grid.time(k_end)) if t_stop is None else max(float(t_stop), float(grid.time(k_end - 1)))
+    impact_time = {(imp.contact, int(round((imp.t - grid.origin) / h))): imp.t for imp in impacts}
+    for i, contact in enumerate(scene.contacts):
+        found = _contact_phases(records.runs[i], grid, k_end, t_final, min_phase)
         for before, after in zip(found, found[1:]):
-            k = int(round(after.t_start / h))
+            k = int(round((after.t_start - grid.origin) / h))
+            t_k = grid.origin + k * h
             if before.mode == "open":
-                t_switch = min((t for (c, step), t in impact_time.items() if c == name and abs(step - k) <= 1),
-                               key=lambda t: abs(t - k * h), default=k * h)
+                t_switch = min((t for (c, step), t in impact_time.items() if c == contact.name and abs(step - k) <= 1),
+                               key=lambda t: abs(t - t_k), default=t_k)
                 kind = "impact"
             else:
-                def slip_velocity(j, contact=scene.contacts[i]):  # with the Jacobian at q_j itself
-                    kin = contact.kinematics(out[0][j], out[1][j], scene.n_dof)
-                    return float(kin.H_T @ out[1][j]) - kin.surface_velocity
+                def slip_velocity(j, contact=contact):  # with the Jacobian at q_j itself
+                    qv = records.qv(j)
+                    if qv is None:
+                        return math.nan
+                    kin = contact.kinematics(qv[0], qv[1], scene.n_dof)
+                    return float(kin.H_T @ qv[1]) - kin.surface_velocity
 
-                offset = _boundary_offset(before.mode, after.mode, k, i, out, packed.contacts[i, C_MU_S], h,
+                offset = _boundary_offset(before.mode, after.mode, k, i, records, packed.contacts[i, C_MU_S], h,
                                           slip_velocity)
-                t_switch = k * h + (0.0 if offset is None else min(max(offset, -2 * h), h))
+                t_switch = t_k + (0.0 if offset is None else min(max(offset, -2 * h), h))
                 kind = _BOUNDARY_KIND.get(after.mode, "stick-slip")
             t_switch = min(max(t_switch, before.t_start), after.t_end)
             before.t_end = after.t_start = float(t_switch)
-            if kind != "impact":
-                events.append(Event(float(t_switch), kind, name,
+            if kind != "impact" and t_switch >= t_first:
+                events.append(Event(float(t_switch), kind, contact.name,
                                     {"from": before.mode, "to": after.mode, "step": k, "located": "interpolated"}))
-        phases[name] = found
+        phases[contact.name] = _from(found, t_first)
     return phases, events
+
+
+def _from(phases, t_first):
+    """The phases from t_first on (a resumed run's history starts a few steps before it)."""
+    kept = [p for p in phases if p.t_end > t_first or p is phases[-1]]
+    if kept:
+        kept[0].t_start = max(kept[0].t_start, t_first)
+    return kept

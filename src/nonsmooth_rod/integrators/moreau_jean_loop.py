@@ -57,13 +57,18 @@ BROAD_PHASE_SLACK = 1e-9
 IMPACT_VELOCITY_TOL = 1e-9
 # Run status codes.
 RUN_OK, RUN_SOLVER_FAILED, RUN_NONFINITE, RUN_STOPPED, RUN_BAD_GEOMETRY = 0, 1, 2, 3, 4
+# (set from Python, between windows: a stop condition held at a kept sample)
+RUN_STOPPED_BY_CONDITION = 5
 # Slots of the int64 `counters` record.
 (K_DONE, K_STATUS, K_FAIL_STEP, K_N_IMPACTS, K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_SOLVER_STATUS,
  K_FAIL_CONTACT, K_FALLBACKS) = range(10)
 N_COUNTERS = 10
-# Float parameters: h, θ, γ (activation), t0, solver rtol. Int parameters: solver code, max
-# iterations, stop contact (−1: none).
-P_H, P_THETA, P_GAMMA, P_T0, P_RTOL = range(5)
+# Float parameters: h, θ, γ (activation), the time origin t0, solver rtol, and the step index
+# of row 0 of the out arrays (a run goes in windows of rows: a step's time is t0 + (k0 + k) h
+# whichever window or restart it falls in, so a restarted run repeats the very same floats).
+# Int parameters: solver code, max iterations, stop contact (−1: none).
+P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0 = range(6)
+N_PARAMS = 6
 I_SOLVER, I_MAX_ITER, I_STOP = range(3)
 
 
@@ -328,7 +333,7 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     hn, ht, active, was_closed, grazing, slip_sign, v_free = work[2], work[3], work[4], work[5], work[6], work[7], work[8]
     q, v, p_normal, p_tangent, slip, state_rec = out[0], out[1], out[2], out[3], out[4], out[5]
     h, theta = params[P_H], params[P_THETA]
-    t = params[P_T0] + k * h
+    t = step_time(params, k)
     v_next = v[k + 1]
     v_next[:] = v_free
     for a in range(na):
@@ -434,8 +439,8 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
 
 @_inlined
 def _step(solver_code, k, f, params, iparams, model, work, out):
-    """One whole step with generalised force f; returns a run status. A literal solver code
-    (run_steps_lemke, compiled_step_lemke, …) compiles that solver only."""
+    """One whole step with generalised force f; returns a run status (the solver read from its
+    code at run time: run_steps and compiled_step serve every solver)."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
     na = begin_step(params, qk, vk, f, model, work)
@@ -452,12 +457,18 @@ def _step(solver_code, k, f, params, iparams, model, work, out):
 
 
 @_inlined
+def step_time(params, k):
+    """t_k = t0 + (k0 + k) h: the start of row k's step, from the run's one origin."""
+    return params[P_T0] + (params[P_K0] + k) * params[P_H]
+
+
+@_inlined
 def step_force(k, params, model, out, f):
     """f = weight + the packed forces at t_k + θh and (q_k, v_k)."""
     weight, ftable = model[1], model[4]
     q, v = out[0], out[1]
     f[:] = weight
-    t = params[P_T0] + (k + params[P_THETA]) * params[P_H]
+    t = params[P_T0] + ((params[P_K0] + k) + params[P_THETA]) * params[P_H]
     if ftable.shape[0] > 0:
         accumulate_forces(t, q[k], v[k], ftable, model[5], model[6], model[7], f)
 

@@ -206,6 +206,13 @@ class Regularized:
 
     name = "regularized"
 
+    SAMPLES_KNOB = "a coarser output_dt or a shorter t_end"  # what keeps fewer samples (the driver's memory refusal says it)
+
+    @staticmethod
+    def samples_estimate(options, duration: float, save_every: float | None) -> float:
+        """How many samples a run keeps (every output_dt; the driver thins to save_every after)."""
+        return duration / options.output_dt + 2
+
     def __init__(self, options: RegularizedOptions | None = None):
         self.options = options or RegularizedOptions()
 

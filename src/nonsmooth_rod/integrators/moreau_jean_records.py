@@ -1,0 +1,321 @@
+"""What a Moreau–Jean run keeps, gathered while it runs, and the state it ends in.
+
+The compiled loop writes its per-step records into a window of rows (moreau_jean_loop's `out`
+arrays, `chunk` steps long after `HISTORY` rows of the steps before). Between windows,
+`Collector.take` keeps from them only what the result needs:
+
+* the samples the result keeps (every step, or one per `save_every`): t, q, v, a, N, T, modes;
+* each contact's runs of one state (start step, state code) — the phases, exactly;
+* around each state change, the rows its boundary is located from (`located_phases` reads the
+  impulses of the 4 steps before it and the slip velocity at the 4 states before it);
+* the impacts, with the rows around them.
+
+So memory follows what is kept, not the number of steps, and a stop condition can be tried
+between windows. `ResumeState` is what the next step reads from the steps before it — q, v,
+the contact memory (closed, grazing, slip signs) and the last HISTORY rows of records (warm
+starts, phase location) — with the step grid (origin, index): a restart continues the very
+same floats.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import moreau_jean_loop as loop
+
+# Rows of records a window keeps from the steps before its first: the warm start reads one, the
+# location of a phase boundary at step k reads steps k − 4 … k − 1 (moreau_jean._boundary_offset).
+HISTORY = 4
+# The largest window (steps): its rows cost 16 n_dof + 32 n_contacts bytes a step.
+MAX_CHUNK = 1 << 16
+# Work arrays of moreau_jean_loop that carry a contact's memory from one step to the next.
+WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
+RECORDS = ("p_normal", "p_tangent", "slip", "states")  # out[2] … out[5]
+
+
+@dataclass
+class ResumeState:
+    """The state a Moreau–Jean step reads: q, v, contact memory and the last records.
+
+    origin, step: the step grid, t_k = origin + k h (step: the index of the end state);
+    on_grid: the run ended on that grid (its last step was a whole h), so a restart goes on
+    with the same k; last_h: the size of the last step; q, v: the last HISTORY + 1 states (the
+    end state last); p_normal, p_tangent, slip, states: the records of the last HISTORY steps;
+    was_closed, grazing, slip_sign: per contact, as moreau_jean_loop keeps them.
+    """
+
+    origin: float
+    step: int
+    h: float
+    on_grid: bool
+    last_h: float
+    q: np.ndarray
+    v: np.ndarray
+    p_normal: np.ndarray
+    p_tangent: np.ndarray
+    slip: np.ndarray
+    states: np.ndarray
+    was_closed: np.ndarray
+    grazing: np.ndarray
+    slip_sign: np.ndarray
+
+    def as_dict(self) -> dict:
+        """JSON-ready (floats round-trip exactly through json)."""
+        return {"method": "moreau-jean", "origin": float(self.origin), "step": int(self.step), "h": float(self.h),
+                "on_grid": bool(self.on_grid), "last_h": float(self.last_h),
+                **{name: np.asarray(getattr(self, name)).tolist() for name in _ARRAYS}}
+
+    @classmethod
+    def from_dict(cls, d: dict, n_dof: int, n_contacts: int) -> "ResumeState":
+        rows = {name: np.asarray(d[name], dtype=np.int64 if name in _INT_ARRAYS else float) for name in _ARRAYS}
+        for name in ("q", "v"):
+            rows[name] = rows[name].reshape(-1, n_dof)
+        for name in RECORDS:
+            rows[name] = rows[name].reshape(-1, n_contacts)
+        return cls(float(d["origin"]), int(d["step"]), float(d["h"]), bool(d["on_grid"]), float(d["last_h"]),
+                   **rows)
+
+
+_ARRAYS = ("q", "v", "p_normal", "p_tangent", "slip", "states", "was_closed", "grazing", "slip_sign")
+_INT_ARRAYS = ("states", "was_closed", "grazing")
+
+
+@dataclass
+class Grid:
+    """The steps of a run: t_k = origin + k h for k = first … first + n_full, then (when t_end
+    is not on the grid) one last step of h_last ending exactly at t_end."""
+
+    origin: float
+    first: int
+    n_full: int
+    h: float
+    h_last: float  # 0: none
+    t_end: float
+
+    @classmethod
+    def of(cls, h: float, t0: float, t_end: float, resume: ResumeState | None) -> "Grid":
+        origin, first = t0, 0
+        if resume is not None and resume.on_grid and resume.h == h:
+            origin, first = resume.origin, resume.step
+        span = (t_end - origin) / h - first
+        n = max(1, int(math.ceil(span - 1e-9)))
+        if abs(span - n) <= 1e-9:
+            return cls(origin, first, n, h, 0.0, t_end)
+        t_before = origin + (first + n - 1) * h
+        return cls(origin, first, n - 1, h, t_end - t_before, t_end)
+
+    @property
+    def n_steps(self) -> int:
+        return self.n_full + (1 if self.h_last else 0)
+
+    @property
+    def last(self) -> int:
+        return self.first + self.n_steps
+
+    def time(self, k: np.ndarray | int):
+        """Times of global step indices (the last one: t_end exactly)."""
+        if isinstance(k, (int, np.integer)):
+            return self.t_end if k == self.last else self.origin + float(k) * self.h
+        t = self.origin + np.asarray(k, dtype=float) * self.h
+        return np.where(np.asarray(k) == self.last, self.t_end, t)
+
+
+class Window:
+    """The loop's out arrays for `chunk` steps after HISTORY rows of the steps before.
+
+    Row r holds the state at step k_base + r and the records of the step leaving it."""
+
+    def __init__(self, n_dof: int, n_contacts: int, chunk: int):
+        rows = HISTORY + chunk
+        capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
+        self.out = (np.empty((rows + 1, n_dof)), np.empty((rows + 1, n_dof)), np.zeros((rows, n_contacts)),
+                    np.zeros((rows, n_contacts)), np.zeros((rows, n_contacts)),
+                    np.zeros((rows, n_contacts), dtype=np.int64), np.zeros(capacity),
+                    np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
+                    np.zeros(loop.N_COUNTERS, dtype=np.int64))
+        self.rows, self.k_base, self.r = rows, 0, 0
+
+    def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
+        q, v = self.out[0], self.out[1]
+        if resume is None:
+            q[0], v[0], self.r = q0, v0, 0
+        else:
+            m = resume.states.shape[0]
+            q[: m + 1], v[: m + 1] = resume.q, resume.v
+            for j, name in enumerate(RECORDS):
+                self.out[2 + j][:m] = getattr(resume, name)
+            self.r = m
+        self.k_base = first - self.r
+
+    def room(self) -> int:
+        return self.rows - self.r
+
+    def slide(self) -> None:
+        """Move the last HISTORY rows to the top: the next window's steps read them."""
+        keep = min(HISTORY, self.r)
+        lo = self.r - keep
+        for a in self.out[:2]:
+            a[: keep + 1] = a[lo: self.r + 1]
+        for a in self.out[2:6]:
+            a[:keep] = a[lo: self.r]
+        self.k_base += lo
+        self.r = keep
+
+    def resume_state(self, grid: Grid, work, last_h: float, on_grid: bool) -> ResumeState:
+        keep = min(HISTORY, self.r)
+        lo = self.r - keep
+        return ResumeState(grid.origin if on_grid else grid.t_end, self.k_base + self.r if on_grid else 0, grid.h,
+                           on_grid, last_h, self.out[0][lo: self.r + 1].copy(), self.out[1][lo: self.r + 1].copy(),
+                           *(a[lo: self.r].copy() for a in self.out[2:6]),
+                           work[WORK_CLOSED].copy(), work[WORK_GRAZING].copy(), work[WORK_SLIP_SIGN].copy())
+
+
+def kept_steps(grid: Grid, lo: int, hi: int, save_every: float | None) -> np.ndarray:
+    """Global steps in [lo, hi] the result keeps: the first of the run, then one per save_every
+    (the first step of each slot of the common origin) and the run's last."""
+    k = np.arange(lo, hi + 1)
+    if save_every is None:
+        keep = np.ones(k.shape, dtype=bool)
+    else:
+        slot = np.floor(k * grid.h / save_every + 1e-9)
+        keep = slot != np.floor((k - 1) * grid.h / save_every + 1e-9)
+    keep |= (k == grid.first) | (k == grid.last)
+    return k[keep]
+
+
+def count_kept(grid: Grid, save_every: float | None) -> int:
+    if save_every is None:
+        return grid.n_steps + 1
+    total, k = 0, grid.first
+    while k <= grid.last:  # in blocks of a window's size: no array of every step
+        hi = min(grid.last, k + MAX_CHUNK)
+        total += kept_steps(grid, k, hi, save_every).size
+        k = hi + 1
+    return total
+
+
+class Collector:
+    """The samples, state runs, boundary rows and impact rows of a run, taken window by window."""
+
+    def __init__(self, grid: Grid, n_dof: int, n_contacts: int, save_every: float | None,
+                 resume: ResumeState | None):
+        n = count_kept(grid, save_every)
+        self.grid, self.save_every, self.resume = grid, save_every, resume
+        self.t, self.q, self.v, self.a = np.empty(n), np.empty((n, n_dof)), np.empty((n, n_dof)), np.empty((n, n_dof))
+        self.N, self.T = np.empty((n, n_contacts)), np.empty((n, n_contacts))
+        self.codes = np.zeros((n, n_contacts), dtype=np.int8)
+        self.n = 0
+        self.runs: list[list[tuple[int, int]]] = [[] for _ in range(n_contacts)]  # (first step, code)
+        self._blocks: list[tuple] = []  # (steps, q, v, p_normal, p_tangent, states, records valid) around changes
+        self._index = None
+        self.impact_rows: list[tuple] = []  # (step, contact, t, q_k, v_k, v_k+1, p_n, p_t)
+        self._codes_before = None
+
+    def step_size(self, k):
+        """Size of the steps ending at global steps k (the shortened last one, a resumed run's first)."""
+        g = self.grid
+        h = np.full(np.shape(k), g.h)
+        if g.h_last:
+            h[np.asarray(k) == g.last] = g.h_last
+        if self.resume is not None:
+            h[np.asarray(k) == g.first] = self.resume.last_h
+        return h
+
+    def take(self, window: Window, k_from: int, k_to: int, final: bool) -> None:
+        """Steps k_from … k_to − 1 are done (states k_from … k_to in the window); `final`: the run
+        ends at k_to."""
+        lo = k_from + 1 if self.n else k_from
+        ks = kept_steps(self.grid, lo, k_to, self.save_every)
+        if final and (ks.size == 0 or ks[-1] != k_to):
+            ks = np.r_[ks, k_to]
+        self._samples(window, ks)
+        self._runs_and_rows(window, k_from, k_to)
+        self._impacts(window)
+
+    def _samples(self, window: Window, ks: np.ndarray) -> None:
+        out, rows = window.out, ks - window.k_base
+        m = slice(self.n, self.n + ks.size)
+        self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
+        h = self.step_size(ks)[:, None]
+        before = np.maximum(rows - 1, 0)
+        has_step = (rows >= 1)[:, None]
+        self.a[m] = np.where(has_step, (out[1][rows] - out[1][before]) / h, np.nan)
+        self.N[m] = np.where(has_step, out[2][before] / h, 0.0)
+        self.T[m] = np.where(has_step, out[3][before] / h, 0.0)
+        self.codes[m] = out[5][before]  # the first sample of a fresh run: the mode of its first step
+        self.n += ks.size
+
+    def _runs_and_rows(self, window: Window, k_from: int, k_to: int) -> None:
+        out = window.out
+        r_lo = 0 if self._codes_before is None else k_from - window.k_base  # a resumed run: from its history
+        codes = out[5][r_lo: k_to - window.k_base]
+        if not codes.shape[0]:
+            return
+        before = codes[:1] - 1 if self._codes_before is None else self._codes_before[None, :]
+        changed = np.vstack([before, codes[:-1]]) != codes
+        rows_changed = np.flatnonzero(changed.any(axis=1))
+        for m in rows_changed:  # few: a contact's state changes at its phase boundaries
+            for i in np.flatnonzero(changed[m]):
+                self.runs[i].append((window.k_base + r_lo + int(m), int(codes[m, i])))
+        if rows_changed.size:
+            self._keep_rows(window, window.k_base + r_lo + rows_changed, k_to)
+        self._codes_before = codes[-1].copy()
+
+    def _keep_rows(self, window: Window, steps: np.ndarray, k_to: int) -> None:
+        """The rows of steps k − HISTORY … k for each state change at step k, as arrays (a
+        contact that chatters changes every step: its rows cost what the per-step records did)."""
+        out = window.out
+        need = np.unique((steps[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
+        need = need[(need >= window.k_base) & (need <= k_to)]
+        r = need - window.k_base
+        rec = np.minimum(r, out[2].shape[0] - 1)
+        self._blocks.append((need, out[0][r], out[1][r], out[2][rec], out[3][rec], out[5][rec], need < k_to))
+        self._index = None
+
+    def _row(self, j):
+        """(q, v, p_normal, p_tangent, states) of global step j (records None if not kept), or None."""
+        if self._index is None:
+            blocks = list(zip(*self._blocks)) if self._blocks else [np.zeros(0, dtype=np.int64)] + [np.zeros(0)] * 6
+            steps, *arrays = (np.concatenate(b) for b in blocks)
+            # a step kept twice (the last of one window, again in the next): its later copy has its records
+            order = np.lexsort((arrays[-1], steps))
+            last = np.r_[steps[order][1:] != steps[order][:-1], True]
+            self._index = (steps[order][last], *(a[order][last] for a in arrays))
+        steps = self._index[0]
+        m = int(np.searchsorted(steps, j))
+        if m == steps.size or steps[m] != j:
+            return None
+        q, v, pn, pt, st, valid = (a[m] for a in self._index[1:])
+        return (q, v, pn, pt, st) if valid else (q, v, None, None, None)
+
+    def _impacts(self, window: Window) -> None:
+        out = window.out
+        counters = out[9]
+        for n in range(int(counters[loop.K_N_IMPACTS])):
+            r, i = int(out[7][n]), int(out[8][n])
+            self.impact_rows.append((window.k_base + r, i, float(out[6][n]), out[0][r].copy(), out[1][r].copy(),
+                                     out[1][r + 1].copy(), out[2][r].copy(), out[3][r].copy()))
+        counters[loop.K_N_IMPACTS] = 0
+
+    def trajectory_arrays(self):
+        n = self.n
+        return self.t[:n], self.q[:n], self.v[:n], self.a[:n], self.N[:n], self.T[:n], self.codes[:n]
+
+    # What located_phases reads, by global step (NaN / −1 where the run has no such row).
+    def p_normal(self, j, i):
+        row = self._row(j)
+        return math.nan if row is None or row[2] is None else float(row[2][i])
+
+    def p_tangent(self, j, i):
+        row = self._row(j)
+        return math.nan if row is None or row[3] is None else float(row[3][i])
+
+    def state(self, j, i):
+        row = self._row(j)
+        return -1 if row is None or row[4] is None else int(row[4][i])
+
+    def qv(self, j):
+        row = self._row(j)
+        return None if row is None else (row[0], row[1])
