@@ -24,3 +24,39 @@ def pytest_configure(config):
     for part, args in (("moreau-jean", []), ("moreau-jean-step", ["--step"])):
         if not _jit.engine_is_warm(part):
             _jit.start_compile_job(part, args)
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture
+def no_space_for(monkeypatch):
+    """`no_space_for("trajectory.csv")`: writing that file fails as on a full disk (ENOSPC), however
+    it is written — through Path.write_text or a file nonsmooth_rod.io opens (write_csv streams
+    blocks of rows into the atomic temporary)."""
+    import builtins
+    import errno
+    import pathlib
+
+    from nonsmooth_rod import io as nr_io
+
+    def refuse(names):
+        def full(name: str) -> bool:
+            return any(name.startswith(f".{n}.") or name == n for n in names)
+
+        real_write_text, real_open = pathlib.Path.write_text, builtins.open
+
+        def write_text(self, text, *args, **kwargs):
+            if full(self.name):
+                raise OSError(errno.ENOSPC, "No space left on device")
+            return real_write_text(self, text, *args, **kwargs)
+
+        def open_(file, mode="r", *args, **kwargs):
+            if any(c in mode for c in "wax") and full(pathlib.Path(file).name):
+                raise OSError(errno.ENOSPC, "No space left on device")
+            return real_open(file, mode, *args, **kwargs)
+
+        monkeypatch.setattr(pathlib.Path, "write_text", write_text)
+        monkeypatch.setattr(nr_io, "open", open_, raising=False)
+
+    return lambda *names: refuse(names)

@@ -73,16 +73,10 @@ def test_the_next_save_removes_a_killed_runs_temp_files_but_not_a_live_ones(tmp_
                                                           "summary.json", "trajectory.csv"]
 
 
-def test_a_full_disk_names_the_file_and_leaves_no_temp(tmp_path, monkeypatch):
-    import errno
-    import pathlib
-
+def test_a_full_disk_names_the_file_and_leaves_no_temp(tmp_path, no_space_for):
     from nonsmooth_rod.io import OutputError
 
-    def no_space(self, *args, **kwargs):
-        raise OSError(errno.ENOSPC, "No space left on device")
-
-    monkeypatch.setattr(pathlib.Path, "write_text", no_space)
+    no_space_for("trajectory.csv", "summary.json")
     with pytest.raises(OutputError, match=r"^cannot write .*trajectory.csv: No space left on device$"):
         save(_ball_run(0.1), tmp_path)
     assert list(tmp_path.iterdir()) == []

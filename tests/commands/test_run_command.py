@@ -242,18 +242,8 @@ def test_run_and_simulate_never_overwrite_each_others_folder(tmp_path, capsys):
     assert f"`nonsmooth-rod animate {out}`" in _one_error_line(capsys)
 
 
-def test_a_full_disk_ends_in_one_line_naming_the_file_with_exit_1(tmp_path, capsys, monkeypatch):
-    import errno
-    import pathlib
-
-    real = pathlib.Path.write_text
-
-    def no_space(self, text, *args, **kwargs):
-        if self.name.startswith(".trajectory.csv."):
-            raise OSError(errno.ENOSPC, "No space left on device")
-        return real(self, text, *args, **kwargs)
-
-    monkeypatch.setattr(pathlib.Path, "write_text", no_space)
+def test_a_full_disk_ends_in_one_line_naming_the_file_with_exit_1(tmp_path, capsys, no_space_for):
+    no_space_for("trajectory.csv")
     out = tmp_path / "full"
     assert main(["run", str(SCENES / "bouncing_ball.toml"), "--no-plot", "--quiet", "--out", str(out)]) == 1
     assert _one_error_line(capsys) == f"nonsmooth-rod: cannot write {out / 'trajectory.csv'}: No space left on device"

@@ -224,6 +224,7 @@ class MoreauJean:
         solver_options = dict(opts.solver_options)
         params = np.zeros(loop.N_PARAMS)
         params[loop.P_H], params[loop.P_THETA], params[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
+        params[loop.P_H_GRID] = opts.h
         params[loop.P_T0], params[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
         iparams = np.array([-1 if solver_code is None else solver_code,
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),

@@ -67,8 +67,8 @@ N_COUNTERS = 10
 # of row 0 of the out arrays (a run goes in windows of rows: a step's time is t0 + (k0 + k) h
 # whichever window or restart it falls in, so a restarted run repeats the very same floats).
 # Int parameters: solver code, max iterations, stop contact (−1: none).
-P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0 = range(6)
-N_PARAMS = 6
+P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0, P_H_GRID = range(7)
+N_PARAMS = 7
 I_SOLVER, I_MAX_ITER, I_STOP = range(3)
 
 
@@ -152,7 +152,9 @@ def begin_step(params, qk, vk, f, model, work):
         predicted = gap + gamma * h * local_dot(hn[i], index, i, vk)
         margin = ACTIVATION_ROUNDOFF
         if was_closed[i]:
-            margin = persistence_margin(h, drift, local_dot(hn[i], index, i, a_free))
+            # the grid's h, not a shortened last step's: a contact resting at the gap the full steps
+            # left it stays closed through the last step (else the ball falls for that step)
+            margin = persistence_margin(params[P_H_GRID], drift, local_dot(hn[i], index, i, a_free))
         if predicted <= margin:
             active[na] = i
             na += 1
