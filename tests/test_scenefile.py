@@ -356,3 +356,15 @@ def test_a_segment_end_on_a_box_edge_reads_from_a_file_and_refuses_a_zero_edge()
     data["contacts"][0].update(edge_end=[0.1, -0.05], end="c")
     with pytest.raises(InputError, match=r"^box.toml: contacts.edge.end: must be one of"):
         parse_scene(data, source="box.toml")
+
+
+def test_save_every_in_a_scene_file_thins_the_kept_samples_and_keeps_the_events():
+    from nonsmooth_rod.scenefile import load_scene, simulate_scene
+
+    every = simulate_scene(load_scene(SCENES / "bouncing_ball.toml"))
+    thinned = simulate_scene(load_scene(SCENES / "bouncing_ball.toml", ["simulation.save_every=0.1"]))
+    assert len(every.t) > 900 and len(thinned.t) == 11  # t_end = 1 s, one sample per 0.1 s
+    assert thinned.t[-1] == every.t[-1] == 1.0
+    assert [i.t for i in thinned.impacts] == [i.t for i in every.impacts]  # located in the run, not sampled
+    with pytest.raises(InputError, match="simulation.save_every"):
+        load_scene(SCENES / "bouncing_ball.toml", ["simulation.save_every=-1"])

@@ -88,6 +88,7 @@ class SceneFile:
     text: str = ""  # the file as read (for a copy next to the results)
     overrides: list = field(default_factory=list)
     segments: dict = field(default_factory=dict)  # segment name -> Segment
+    save_every: float | None = None  # [simulation] save_every: one kept sample per this many seconds
 
 
 class _Where:
@@ -496,7 +497,7 @@ def _options_class(method: str):
     return integrator_classes(method)[1]
 
 
-def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
+def _simulation(w, data, contact_names) -> tuple[str, float, dict, list, float | None]:
     sim = data.get("simulation", _REQUIRED)
     if sim is _REQUIRED:
         raise w.error("simulation", "missing: give [simulation] with at least t_end")
@@ -504,10 +505,11 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list]:
         raise w.error("simulation", f"must be a table, got {quoted(sim)}")
     method = _text(w, sim, "method", "simulation", "moreau-jean", METHODS)
     t_end = _number(w, sim, "t_end", "simulation", positive=True)
+    save_every = _number(w, sim, "save_every", "simulation", positive=True) if "save_every" in sim else None
     stop = _stop(w, sim, contact_names)
     options = _method_options(w, sim, method)
     _check_options(w, _options_class(method), options, stop)
-    return method, t_end, options, stop
+    return method, t_end, options, stop, save_every
 
 
 def _stop(w, sim: dict, contact_names) -> list:
@@ -530,7 +532,7 @@ def _method_options(w, sim: dict, method: str) -> dict:
     """Options of the chosen method: [simulation.<method>] over the flat keys of [simulation].
     Tables of the other methods are checked for their key names only, so that
     `--set simulation.method=event-driven` switches to options the file already holds."""
-    flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop") and k not in METHODS}
+    flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop", "save_every") and k not in METHODS}
     _check_keys(w, flat, _allowed_options(method) + list(METHODS), "simulation")
     for name in METHODS:
         if name in sim:
@@ -681,26 +683,29 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     q0, v0 = _initial(w, data, body_names)
     _check_overlap(w, scene, q0, v0)
     contact_names = [c.name for c in contacts]
-    method, t_end, options, stop = _simulation(w, data, contact_names)
+    method, t_end, options, stop, save_every = _simulation(w, data, contact_names)
     return SceneFile(scene, q0, v0, t_end, method, options, stop, body_names, contact_names, list(lines),
                      [f.name for f in forces], shapes, lines, data, source,
-                     title=str(data.get("title", "")), segments=segments)
+                     title=str(data.get("title", "")), segments=segments, save_every=save_every)
 
 
 # --- running ----------------------------------------------------------------------------------------
 
-def run_method(scene, q0, v0, t_end: float, method: str, options: dict, stop=(), t0: float = 0.0):
+def run_method(scene, q0, v0, t_end: float, method: str, options: dict, stop=(), t0: float = 0.0,
+               save_every: float | None = None):
     """The one place that runs a scene file's scene: nr.simulate."""
     from .driver import simulate
 
-    return simulate(scene, q0, v0, t_end, method, t0=t0, stop=list(stop) or None, **options)
+    return simulate(scene, q0, v0, t_end, method, t0=t0, stop=list(stop) or None, save_every=save_every,
+                    **options)
 
 
 def simulate_scene(sf: SceneFile):
     """Run a loaded scene file with its own method, options and stop conditions; a refusal by the
     driver (a method that does not handle a contact kind, a run too large for memory) names the file."""
     try:
-        result = run_method(sf.scene, sf.q0, sf.v0, sf.t_end, sf.method, sf.options, sf.stop)
+        result = run_method(sf.scene, sf.q0, sf.v0, sf.t_end, sf.method, sf.options, sf.stop,
+                            save_every=sf.save_every)
     except InputError as err:
         raise InputError(f"{sf.source}: simulation: {err}") from None
     result.scene_file = sf  # names and shapes for files, figures and animations
