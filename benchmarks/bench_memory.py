@@ -62,11 +62,26 @@ def library_case(steps: int, save_every) -> dict:
             "estimate": estimate, "growth": growth}
 
 
-def _cli_peak(steps: int, folder: str) -> int:
+def library_case_fresh(steps: int, save_every) -> dict:
+    """library_case in a process of its own: in a process that ran anything large before, the
+    allocator reuses what that freed and the run's growth is hidden (a 1e7-step run measured
+    0.0 MB of growth after another one)."""
+    import json
+
+    code = ("import json, sys; sys.path.insert(0, sys.argv[1]); import bench_memory; "
+            f"print(json.dumps(bench_memory.library_case({steps}, {save_every!r})))")
+    done = subprocess.run([sys.executable, "-c", code, str(Path(__file__).resolve().parent)], env=_env(),
+                          capture_output=True, text=True, check=True)
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+def _cli_peak(steps: int, folder: str, save_every=None) -> int:
     """Peak RSS (bytes) of `nonsmooth-rod run` of the bouncing ball for `steps` steps."""
     cmd = [sys.executable, "-m", "nonsmooth_rod.cli", "run", str(ROOT / "examples/scenes/bouncing_ball.toml"),
            "--set", f"simulation.t_end={steps * H!r}", "--set", f"simulation.moreau-jean.h={H!r}",
            "--out", folder, "--no-plot", "--quiet"]
+    if save_every is not None:
+        cmd += ["--set", f"simulation.save_every={save_every!r}"]
     proc = subprocess.Popen(cmd, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(proc.pid, 0)
     if os.waitstatus_to_exitcode(status) not in (0, 1):
@@ -74,7 +89,7 @@ def _cli_peak(steps: int, folder: str) -> int:
     return usage.ru_maxrss * 1024
 
 
-def cli_case(steps: int) -> dict:
+def cli_case(steps: int, save_every=None) -> dict:
     from nonsmooth_rod.integrators import check_output_size
     from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
     from nonsmooth_rod.toys import BouncingBall
@@ -82,10 +97,11 @@ def cli_case(steps: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         _cli_peak(200, tmp)  # a first process may compile (a changed source): not the baseline
         small = _cli_peak(200, tmp)
-        big = _cli_peak(steps, tmp)
-    estimate = check_output_size(MoreauJean.samples_estimate(MoreauJeanOptions(h=H), steps * H, None),
+        big = _cli_peak(steps, tmp, save_every)
+    estimate = check_output_size(MoreauJean.samples_estimate(MoreauJeanOptions(h=H), steps * H, save_every),
                                  BouncingBall().scene())
-    return {"interface": "cli", "steps": steps, "save_every": None, "samples": steps + 1, "estimate": estimate,
+    samples = steps + 1 if save_every is None else int(round(steps * H / save_every)) + 1
+    return {"interface": "cli", "steps": steps, "save_every": save_every, "samples": samples, "estimate": estimate,
             "growth": big - small}
 
 
@@ -122,9 +138,9 @@ def main(argv=None) -> int:
     step_counts = [200_000] if args.quick else [int(s) for s in args.steps]
     print(table([]), flush=True)
     for steps in step_counts:  # each row as soon as it is measured
-        cases = [lambda: library_case(steps, None), lambda: library_case(steps, 1000 * H)]
+        cases = [lambda: library_case_fresh(steps, None), lambda: library_case_fresh(steps, 1000 * H)]
         if not args.quick and steps <= args.cli_max_steps:
-            cases.append(lambda: cli_case(steps))
+            cases += [lambda: cli_case(steps), lambda: cli_case(steps, 1000 * H)]
         for case in cases:
             print(table([case()]).splitlines()[-1], flush=True)
     if args.stop:

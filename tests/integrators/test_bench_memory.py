@@ -16,26 +16,11 @@ def _bench_memory():
     return module
 
 
-def _library_case_in_a_fresh_process(steps, save_every) -> dict:
-    """bench_memory.library_case in a process of its own: in this one, memory that earlier tests
-    freed is reused by the allocator and hides the run's growth."""
-    import json
-    import os
-    import subprocess
-
-    code = (f"import importlib.util, json, sys; spec = importlib.util.spec_from_file_location('b', {str(ROOT / 'benchmarks' / 'bench_memory.py')!r}); "
-            "b = importlib.util.module_from_spec(spec); spec.loader.exec_module(b); "
-            f"print(json.dumps(b.library_case({steps}, {save_every!r})))")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout.splitlines()[-1])
-
-
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_peak_memory_follows_what_is_kept_and_a_stop_ends_early():
     bench = _bench_memory()
-    every, thinned = (_library_case_in_a_fresh_process(200_000, save_every) for save_every in (None, 0.1))
+    # each in a fresh process: in this one, memory earlier tests freed is reused and hides the growth
+    every, thinned = (bench.library_case_fresh(200_000, save_every) for save_every in (None, 0.1))
     assert thinned["samples"] == 201 and every["samples"] == 200_001
     # thinning while running: the peak follows the samples kept (the window of rows stays)
     assert thinned["growth"] < 0.6 * every["growth"]
