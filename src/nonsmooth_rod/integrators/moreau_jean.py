@@ -143,7 +143,8 @@ class Engine:
     def __init__(self, compiled: bool, part: str, what: str, job: list):
         self.part, self.what, self.job = part, what, job
         self.probing = compiled and not _jit.engine_is_warm(part) and _jit.compile_policy() == "auto"
-        self.kernels = loop_kernels(compiled and not self.probing)
+        self.compiled = compiled and not self.probing  # the kernels are numba's (not the interpreted twins)
+        self.kernels = loop_kernels(self.compiled)
 
     def steps(self, n: int) -> int:
         """How many of the n steps the next call may run (the probe's, while probing)."""
@@ -156,13 +157,13 @@ class Engine:
         self.probing = False
         compile_s, _ = _jit.compile_estimate_s(self.part)
         if seconds / steps * steps_left > compile_s and status == loop.RUN_OK:
-            self.kernels = loop
+            self.compiled, self.kernels = True, loop
         else:
             _jit.compile_in_background(self.part, self.job, self.what, compile_s)
 
     def compiling(self):
         """The compile notice and lock around a call of the compiled kernels (nothing when warm)."""
-        return _jit.compiling(self.part, self.what) if self.kernels is loop else contextlib.nullcontext()
+        return _jit.compiling(self.part, self.what) if self.compiled else contextlib.nullcontext()
 
 
 class MoreauJean:
@@ -214,7 +215,7 @@ class MoreauJean:
             ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop))
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
-                 "compiled": engine.kernels is loop and solver_code is not None,
+                 "compiled": engine.compiled and solver_code is not None,
                  "force_callback": scene.applied_force is not None}
         return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
 

@@ -168,6 +168,16 @@ def _fill_disk_a(row, offset, radius) -> None:
     row[C_RADIUS_A] = radius
 
 
+def _check_disk_on(contact, obstacle: str, obstacle_type) -> None:
+    """The fields a body's disk (or point) against a fixed obstacle shares, checked and converted."""
+    contact.name = _contact_name(contact.name)
+    contact.body = require_index(f"contact {contact.name!r} body", contact.body)
+    contact.offset = require_point(f"contact {contact.name!r} offset", contact.offset)
+    contact.radius = require_nonnegative(f"contact {contact.name!r} radius", contact.radius)
+    _require_type(f"contact {contact.name!r} {obstacle}", getattr(contact, obstacle), obstacle_type)
+    _require_type(f"contact {contact.name!r} law", contact.law, ContactLaw)
+
+
 @dataclass
 class DiskOnLine(_PackedRelation):
     """A disk (ball) of radius `radius` fixed on `body` touching a fixed Line.
@@ -184,12 +194,7 @@ class DiskOnLine(_PackedRelation):
     name: str = "contact"
 
     def __post_init__(self):
-        self.name = _contact_name(self.name)
-        self.body = require_index(f"contact {self.name!r} body", self.body)
-        self.offset = require_point(f"contact {self.name!r} offset", self.offset)
-        self.radius = require_nonnegative(f"contact {self.name!r} radius", self.radius)
-        _require_type(f"contact {self.name!r} line", self.line, Line)
-        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
+        _check_disk_on(self, "line", Line)
 
     @property
     def bodies(self) -> tuple[int, ...]:
@@ -228,12 +233,7 @@ class DiskOnSegment(_PackedRelation):
     _no_normal = "the disk centre is on the segment's end point, the contact normal is undefined"
 
     def __post_init__(self):
-        self.name = _contact_name(self.name)
-        self.body = require_index(f"contact {self.name!r} body", self.body)
-        self.offset = require_point(f"contact {self.name!r} offset", self.offset)
-        self.radius = require_nonnegative(f"contact {self.name!r} radius", self.radius)
-        _require_type(f"contact {self.name!r} segment", self.segment, Segment)
-        _require_type(f"contact {self.name!r} law", self.law, ContactLaw)
+        _check_disk_on(self, "segment", Segment)
 
     @property
     def bodies(self) -> tuple[int, ...]:
