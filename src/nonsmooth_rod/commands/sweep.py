@@ -185,24 +185,37 @@ def _map_axes_option(text, grid) -> tuple:
     return map_axes_of(grid, *parts)
 
 
-def _report(result) -> None:
+def _counts_and_rate(title: str, column: str, labels) -> object:
+    """Print a table of how many points each label has, and the computing rate; returns the console."""
     from collections import Counter
 
     from rich.console import Console
     from rich.table import Table
 
+    from .options import escape
+
     console = Console()
-    counts = Counter(r["scenario"] for r in result.grid_rows)
-    table = Table(title=f"regime map, {len(result.grid_rows)} points")
-    table.add_column("scenario")
+    table = Table(title=title)
+    table.add_column(column)
     table.add_column("points", justify="right")
-    for name, n in sorted(counts.items()):
-        table.add_row(name, str(n))
+    for name, n in sorted(Counter(labels).items()):
+        table.add_row(escape(name), str(n))
     console.print(table)
-    console.print(f"{result.computed} computed, {result.reused} from an earlier run")
-    from ..rod.regime import accuracy_text
+    return console
+
+
+def _rate_line(result) -> str:
     rate = result.computed / max(result.compute_s, 1e-9)
-    console.print(f"{rate:,.0f} points/s ({result.compute_s:.2f} s computing, {result.wall_s:.2f} s in all)")
+    return (f"{result.computed} computed, {result.reused} from an earlier run; {rate:,.0f} points/s "
+            f"({result.compute_s:.2f} s computing, {result.wall_s:.2f} s in all)")
+
+
+def _report(result) -> None:
+    console = _counts_and_rate(f"regime map, {len(result.grid_rows)} points", "scenario",
+                               (r["scenario"] for r in result.grid_rows))
+    console.print(_rate_line(result))
+    from ..rod.regime import accuracy_text
+
     console.print(accuracy_text(result.accuracy))
     for th in result.thresholds[:12]:
         extra = "".join(f", {k} = {v:g}" for k, v in th.params.items())
@@ -246,24 +259,11 @@ def cmd_scene_map(args) -> int:
 
 
 def _report_map(result) -> None:
-    from collections import Counter
-
-    from rich.console import Console
-    from rich.table import Table
-
     from .options import escape
 
-    console = Console()
-    counts = Counter(r["regime"] for r in result.rows)
-    table = Table(title=f"map of {len(result.rows)} points: regimes (each contact's phase sequence)")
-    table.add_column("regime")
-    table.add_column("points", justify="right")
-    for name, n in sorted(counts.items()):
-        table.add_row(escape(name), str(n))
-    console.print(table)
-    rate = result.computed / max(result.compute_s, 1e-9)
-    console.print(f"{result.computed} computed, {result.reused} from an earlier run; {rate:,.0f} points/s "
-                  f"({result.compute_s:.2f} s computing, {result.wall_s:.2f} s in all)")
+    console = _counts_and_rate(f"map of {len(result.rows)} points: regimes (each contact's phase sequence)",
+                               "regime", (r["regime"] for r in result.rows))
+    console.print(_rate_line(result))
     for b in result.boundaries[:20]:
         console.print(escape(f"boundary along {b['axis']} in [{b['lo']:.6g}, {b['hi']:.6g}]: "
                              f"{b['regime_lo']} | {b['regime_hi']}"))

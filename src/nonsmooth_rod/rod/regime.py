@@ -243,13 +243,9 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
     ProcessPoolExecutor), used as given and not shut down here; `jobs` then only sizes the
     chunks (give the number of workers). `map_axes`: the figure's (x, y) axes (default: see
     `regime_map_figure`). The table in memory: `result.frame`."""
-    if jobs < 1:
-        raise InputError(f"jobs must be at least 1, got {jobs}")
+    out_dir = runner.check_sweep_args(out_dir, jobs)
     if not 0 <= check_points <= 1000:
         raise InputError(f"check_points must lie in [0, 1000], got {check_points}")
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"--out '{out_dir}' exists and is not a folder")
     _check_problems(base, grid)
     out_dir.mkdir(parents=True, exist_ok=True)
     remove_stale_temps(out_dir)

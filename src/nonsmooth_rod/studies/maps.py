@@ -189,13 +189,9 @@ def sweep(scene, axes, out_dir, *, sets=(), outcomes=None, refine: int = 0, jobs
     data, source = scene_data(scene, sets)
     axes = _axes_of(axes)
     _check_axes(data, source, axes)
-    if jobs < 1:
-        raise InputError(f"jobs must be at least 1, got {jobs}")
+    out_dir = runner.check_sweep_args(out_dir, jobs)
     if not 0 <= refine <= 40:
         raise InputError(f"refine must lie in [0, 40] bisection steps, got {refine}")
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"--out '{out_dir}' exists and is not a folder")
     names = _base_run(data, source)  # before forking: the workers inherit the loaded engine
     paths = tuple(a.path for a in axes)
     columns = _columns(paths, names, outcomes)

@@ -170,6 +170,16 @@ def has_pyarrow() -> bool:
     return importlib.util.find_spec("pyarrow") is not None
 
 
+def check_sweep_args(out_dir, jobs: int) -> Path:
+    """The arguments every sweep shares, checked: at least one job, an --out that is (or can be) a folder."""
+    if jobs < 1:
+        raise InputError(f"jobs must be at least 1, got {jobs}")
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"--out '{out_dir}' exists and is not a folder")
+    return out_dir
+
+
 @contextlib.contextmanager
 def folder_lock(out_dir: Path):
     """Refuse a second sweep writing into the same folder at the same time (their appends
