@@ -27,7 +27,6 @@ and the accuracy check.
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import time
@@ -199,23 +198,10 @@ def _settings_record(base: RodProblem, settings: SweepSettings, grid: Grid) -> d
 def _prepare_folder(out_dir: Path, record: dict, columns) -> list[dict]:
     """Check a folder's earlier sweep is compatible; return its readable rows."""
     csv_path, settings_path = out_dir / CSV_NAME, out_dir / SETTINGS_NAME
-    if settings_path.exists():
-        try:
-            old = json.loads(settings_path.read_text(encoding="utf-8"))
-        except (json.JSONDecodeError, UnicodeDecodeError):
-            raise InputError(f"{settings_path} is not valid JSON: remove it or use another --out") from None
-        old = {k: old.get(k) for k in record}  # the grid, provenance and accuracy may differ
-        if json.loads(dumps_json(old)) != json.loads(dumps_json(record)):
-            raise InputError(f"{out_dir} holds a sweep made with other settings, axes or another body "
-                             f"(see {settings_path}): use another --out or remove the folder")
-    elif csv_path.exists():
-        raise InputError(f"{csv_path} exists without {SETTINGS_NAME}: not a sweep folder of this "
-                         "program; use another --out")
+    runner.claim_folder(out_dir, csv_path, settings_path, record, "a sweep made with other settings, axes or another body")
     rows = []
     if csv_path.exists():
         rows, _bad = read_rows(csv_path, columns)
-    if not settings_path.exists():
-        write_json(settings_path, record)
     # Rewrite what was readable (dropping a half-written last line) before appending to it.
     write_rows(csv_path, rows, columns)
     return rows

@@ -16,7 +16,6 @@ neighbouring grid points of different regimes K times along their axis: DIR/boun
 """
 from __future__ import annotations
 
-import json
 import math
 import time
 from dataclasses import dataclass, field
@@ -25,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _jit
-from ..io import dumps_json, output_error, provenance, remove_stale_temps, write_csv, write_json
+from ..io import output_error, provenance, remove_stale_temps, write_csv, write_json
 from ..scenefile import parse_scene, read_data, simulate_scene
 from ..validation import InputError
 from . import runner
@@ -144,20 +143,8 @@ def _columns(paths, names, outcomes) -> tuple:
 def _prepare_folder(out_dir: Path, record: dict, columns, paths) -> list[dict]:
     """Check the folder's earlier map was made from the same scene and axes; its readable rows."""
     csv_path, settings_path = out_dir / CSV_NAME, out_dir / SETTINGS_NAME
-    if settings_path.exists():
-        try:
-            old = json.loads(settings_path.read_text(encoding="utf-8"))
-        except (json.JSONDecodeError, UnicodeDecodeError):
-            raise InputError(f"{settings_path} is not valid JSON: remove it or use another --out") from None
-        old = {k: old.get(k) for k in record}
-        if json.loads(dumps_json(old)) != json.loads(dumps_json(record)):
-            raise InputError(f"{out_dir} holds a map of another scene, other --set values or other axes "
-                             f"(see {settings_path}): use another --out or remove the folder")
-    elif csv_path.exists():
-        raise InputError(f"{csv_path} exists without {SETTINGS_NAME}: not a map folder; use another --out")
+    runner.claim_folder(out_dir, csv_path, settings_path, record, "a map of another scene, other --set values or other axes")
     rows = runner.read_table(csv_path, columns, TEXT_COLUMNS, paths, "regime")[0] if csv_path.exists() else []
-    if not settings_path.exists():
-        write_json(settings_path, record)
     runner.write_table(csv_path, rows, columns, paths)  # drop a half-written last line before appending
     return rows
 

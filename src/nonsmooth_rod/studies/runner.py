@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
+import json
 import math
 import os
 import sys
@@ -15,7 +16,7 @@ import numpy as np
 from concurrent.futures import FIRST_COMPLETED, wait
 from pathlib import Path
 
-from ..io import output_error, write_text
+from ..io import dumps_json, output_error, write_json, write_text
 from ..validation import InputError
 
 KEY_DIGITS = 12  # point values are matched to this many decimals when resuming
@@ -168,6 +169,23 @@ def has_pyarrow() -> bool:
     import importlib.util
 
     return importlib.util.find_spec("pyarrow") is not None
+
+
+def claim_folder(out_dir: Path, csv_path: Path, settings_path: Path, record: dict, other: str) -> None:
+    """Refuse a folder whose earlier sweep was made with other settings (`other` says what differs)
+    or whose table has no settings beside it; record the settings of a new one."""
+    if settings_path.exists():
+        try:
+            old = json.loads(settings_path.read_text(encoding="utf-8"))
+        except (json.JSONDecodeError, UnicodeDecodeError):
+            raise InputError(f"{settings_path} is not valid JSON: remove it or use another --out") from None
+        old = {k: old.get(k) for k in record}  # the grid, provenance and accuracy may differ
+        if json.loads(dumps_json(old)) != json.loads(dumps_json(record)):
+            raise InputError(f"{out_dir} holds {other} (see {settings_path}): use another --out or remove the folder")
+    elif csv_path.exists():
+        raise InputError(f"{csv_path} exists without {settings_path.name}: not a sweep folder; use another --out")
+    else:
+        write_json(settings_path, record)
 
 
 def check_sweep_args(out_dir, jobs: int) -> Path:
