@@ -93,6 +93,9 @@ def _run(integrator, scene, q0, v0, t0, t_end, save_every, callables, resume) ->
     where it can (Moreau–Jean); otherwise from 0 on a shifted scene, stops and thinning after."""
     if getattr(integrator, "absolute_time", False):
         return integrator.run(scene, q0, v0, t_end, t0=t0, resume=resume, save_every=save_every, stop=callables)
+    if resume is not None:
+        raise InputError(f"resume: only a Moreau–Jean run continues from an end state; method "
+                         f"{integrator.name!r} restarts from (q0, v0)")
     result = integrator.run(_shifted(scene, t0), q0, v0, t_end - t0)
     if t0:
         _shift_times(result, t0)

@@ -5,6 +5,8 @@ import math
 import numpy as np
 import pytest
 
+from nonsmooth_rod.validation import InputError
+
 import nonsmooth_rod as nr
 
 G = 9.81
@@ -117,3 +119,14 @@ def test_a_method_refuses_contacts_it_does_not_handle_before_running():
     # e = 0, equal masses: a perfectly plastic impact, both move on at half the speed
     assert run.v[-1, [0, 3]] == pytest.approx([0.5, 0.5], rel=1e-12)
     assert [i.contact for i in run.impacts] == ["ab"]
+
+
+def test_resume_is_refused_by_a_method_that_restarts_from_the_state():
+    import nonsmooth_rod as nr
+    from nonsmooth_rod import toys
+
+    ball = toys.BouncingBall()
+    first = nr.simulate(ball.scene(), *ball.initial_state(), 0.05, h=1e-3)
+    with pytest.raises(InputError, match="resume: only a Moreau–Jean run continues from an end state"):
+        nr.simulate(ball.scene(), first.trajectory.q[-1], first.trajectory.v[-1], 0.1, method="event-driven",
+                    t0=0.05, resume=first.end_state)

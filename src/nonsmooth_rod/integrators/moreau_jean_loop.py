@@ -13,7 +13,8 @@ A step of size h from (q_k, v_k), for a packed scene (model.packing):
 compiled call, whichever solver iparams names); `compiled_step` runs one step with a force given by the caller (the step-wise
 loop that calls back a Python `applied_force`). Arrays are grouped in three tuples so every
 kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
-(records). Their layouts are built by `allocate` in moreau_jean.py.
+(records). model and work are built by `_model_and_work` in moreau_jean.py, out by `Window` in
+moreau_jean_records.py (the run in windows of rows).
 """
 from __future__ import annotations
 

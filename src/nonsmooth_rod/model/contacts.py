@@ -341,3 +341,7 @@ class DiskOnDisk(_PackedRelation):
         row[C_OFF_BX], row[C_OFF_BY] = self.offset_b
         row[C_RADIUS_B] = self.radius_b
         return KIND_DISK_ON_DISK, self.body_a, self.body_b
+
+
+# Every contact relation a scene can hold, by the names users write (for error messages).
+RELATION_NAMES = ("DiskOnLine", "PointOnLine", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "DiskOnDisk")

@@ -52,9 +52,10 @@ def pack_contacts(contacts, n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
     index = np.zeros((len(contacts), 3), dtype=np.int64)
     for i, c in enumerate(contacts):
         if not hasattr(c, "fill_row"):
-            raise InputError(f"contact {i} ({getattr(c, 'name', '?')}): the engine takes DiskOnLine, "
-                             f"PointOnLine, DiskOnSegment, PointOnSegment and DiskOnDisk contacts, "
-                             f"got {type(c).__name__}")
+            from .contacts import RELATION_NAMES
+
+            raise InputError(f"contact {i} ({getattr(c, 'name', '?')}): the engine takes "
+                             f"{', '.join(RELATION_NAMES)} contacts, got {type(c).__name__}")
         row = table[i]
         index[i] = c.fill_row(row)
         friction, impact = c.law.friction, c.law.impact

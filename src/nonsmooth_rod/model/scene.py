@@ -58,8 +58,10 @@ class Scene:
         seen = set()
         for contact in self.contacts:
             if not hasattr(contact, "bodies") or not hasattr(contact, "kinematics"):
-                raise InputError(f"scene contacts must be contact relations (DiskOnLine, PointOnLine, DiskOnSegment, "
-                                 f"DiskOnDisk), got {type(contact).__name__}")
+                from .contacts import RELATION_NAMES
+
+                raise InputError(f"scene contacts must be contact relations ({', '.join(RELATION_NAMES)}), "
+                                 f"got {type(contact).__name__}")
             for body in contact.bodies:
                 if body >= len(self.bodies):
                     raise InputError(f"contact {contact.name!r} refers to body {body}, but the scene has "
