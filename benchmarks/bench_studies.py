@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 from nonsmooth_rod.scenefile import parse_scene, simulate_scene  # noqa: E402
-from nonsmooth_rod.studies.fit import fit  # noqa: E402
+from nonsmooth_rod.studies.fitting import fit  # noqa: E402
 from nonsmooth_rod.studies.maps import scene_data, sweep  # noqa: E402
 from nonsmooth_rod.studies.measurements import Measurements  # noqa: E402
 from nonsmooth_rod.studies.outcome import contact_events  # noqa: E402

@@ -366,5 +366,6 @@ def test_save_every_in_a_scene_file_thins_the_kept_samples_and_keeps_the_events(
     assert len(every.t) > 900 and len(thinned.t) == 11  # t_end = 1 s, one sample per 0.1 s
     assert thinned.t[-1] == every.t[-1] == 1.0
     assert [i.t for i in thinned.impacts] == [i.t for i in every.impacts]  # located in the run, not sampled
+    assert len(thinned.restart(t_end=1.5).t) == 6  # a restart keeps the file's save_every (1.0 … 1.5 s)
     with pytest.raises(InputError, match="simulation.save_every"):
         load_scene(SCENES / "bouncing_ball.toml", ["simulation.save_every=-1"])

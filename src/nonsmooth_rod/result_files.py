@@ -173,7 +173,7 @@ def scene_description(result) -> dict | None:
 def _run_options(result) -> dict:
     sf = getattr(result, "scene_file", None)
     if sf is not None:
-        return {**sf.options, "t_end": sf.t_end, "stop": sf.stop}
+        return {**sf.options, "t_end": sf.t_end, "stop": sf.stop, "save_every": sf.save_every}
     inputs = getattr(result, "run_inputs", None) or {}
     keys = ("t0", "t_end", "save_every", "stop")
     return {**_plain(inputs.get("options", {})), **{k: _plain(inputs[k]) for k in keys if k in inputs}}
@@ -413,4 +413,4 @@ def _setup_of(result):
     if sf is None:
         raise InputError("restart needs the scene: a results folder with its scene copy, a scene-file run or "
                          "a result of nr.simulate")
-    return sf.scene, sf.method, dict(sf.options), list(sf.stop) or None, None
+    return sf.scene, sf.method, dict(sf.options), list(sf.stop) or None, sf.save_every

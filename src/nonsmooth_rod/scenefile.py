@@ -595,22 +595,23 @@ def apply_override(data: dict, assignment: str, source: str = "--set") -> None:
 
 # --- reading a file ---------------------------------------------------------------------------------
 
-def read_data(path) -> tuple[dict, str]:
-    """The file's content as a dict (TOML, or JSON by the .json suffix) and its text."""
+def read_data(path, what: str = "scene") -> tuple[dict, str]:
+    """The file's content as a dict (TOML, or JSON by the .json suffix) and its text; `what` the
+    file holds (a scene, measured events) names it in the one-line errors."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
-        raise InputError(f"{path}: cannot read the scene file ({getattr(err, 'strerror', None) or err})") from None
+        raise InputError(f"{path}: cannot read the {what} file ({getattr(err, 'strerror', None) or err})") from None
     kind = "JSON" if path.suffix.lower() == ".json" else "TOML"
     try:
         data = json.loads(text) if kind == "JSON" else tomllib.loads(text)
     except RecursionError:
-        raise InputError(f"{path}: not a scene: tables or lists nested too deep to read") from None
+        raise InputError(f"{path}: not a {what} file: tables or lists nested too deep to read") from None
     except ValueError as err:  # JSONDecodeError, TOMLDecodeError, an integer over Python's digit limit
         raise InputError(f"{path}: not valid {kind}: {str(err)[:200]}") from None
     if not isinstance(data, dict):
-        raise InputError(f"{path}: the scene must be a table/object at the top level")
+        raise InputError(f"{path}: the {what} must be a table/object at the top level")
     return data, text
 
 

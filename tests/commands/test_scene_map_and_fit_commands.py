@@ -53,6 +53,8 @@ BAD_SWEEPS = [
     (["--axis", "contacts.foot.law.bogus=1,2"], "unknown key"),
     (["--axis", "contacts.foot.law.mu_s"], "expected PATH=START:STOP:N"),
     (["--axis", "contacts.foot.law.mu_s=0.1:0.2:3", "--mu-s", "0.3"], "option of the rod's sweep"),
+    (["--axis", "contacts.foot.law.mu_s=0.1:0.2:3", "--g", "3"], "--g is an option of the rod's sweep"),
+    (["--axis", "contacts.foot.law.mu_s=0.1:0.2:3", "--mass", "1"], "--mass is an option of the rod's sweep"),
     (["--axis", "contacts.foot.law.mu_s=0.5,0.6", "--outcome", "colour"], "not an outcome"),
     (["--axis", "contacts.foot.law.mu_s=0.5,0.6", "--map-axes", "gravity,contacts.foot.law.mu_s"], "not an axis"),
 ]
@@ -73,8 +75,11 @@ def test_an_axis_without_a_scene_is_refused(capsys):
 BAD_EVENTS = [
     ('[[events]]\nkind = "impact"\ncontact = "C"\nt = 0.3\nsigma = 0.001\n', "no contact named 'C'"),
     ('[[events]]\nkind = "bounce"\ncontact = "B"\nt = 0.3\nsigma = 0.001\n', "kind 'bounce'"),
-    ('[[events]]\nkind = "impact"\ncontact = "B"\nt = 0.3\nsigma = 0\n', "sigma must be > 0"),
+    ('[[events]]\nkind = "impact"\ncontact = "B"\nt = 0.3\nsigma = 0\n', "sigma must be positive"),
     ('[[events]]\nkind = "impact"\ncontact = "B"\nt = 0.3\n', "missing sigma"),
+    ('[[events]]\nkind = "impact"\ncontact = "B"\nt = "0.3"\nsigma = 0.001\n', "t must be a number"),
+    ('[[events]]\nkind = "impact"\ncontact = "B"\nt = 0.3\nsigma = true\n', "sigma must be a number"),
+    ('[[events]]\nkind = "impact"\ncontact = "B"\nt = -0.3\nsigma = 0.001\n', "t must be non-negative"),
     (EVENTS + EVENTS, "increasing times"),
 ]
 

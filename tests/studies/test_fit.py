@@ -12,7 +12,7 @@ import pytest
 
 from nonsmooth_rod.result_files import trajectory_columns
 from nonsmooth_rod.scenefile import parse_scene, simulate_scene
-from nonsmooth_rod.studies.fit import fit
+from nonsmooth_rod.studies.fitting import fit
 from nonsmooth_rod.studies.maps import scene_data
 from nonsmooth_rod.studies.measurements import Measurements
 

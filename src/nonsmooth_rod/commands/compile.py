@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 
-
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "compile", help="compile the Moreau–Jean engine now, into numba's on-disk cache",

@@ -28,13 +28,13 @@ def register(subparsers) -> None:
                    help="a scene key to estimate, with optional bounds; repeatable")
     p.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
                    help="override a value of the scene file (also the fit's start); repeatable")
-    add_output_options(p, default_out="fit")
+    add_output_options(p, default_out="fit", figure="fit.png", force=False)
     p.set_defaults(handler=cmd_fit)
 
 
 def cmd_fit(args) -> int:
     from ..io import dumps_json, write_json
-    from ..studies.fit import fit
+    from ..studies.fitting import fit
     from .run import writable_folder
 
     result = fit(args.scene, args.measured, args.free, sets=args.set)

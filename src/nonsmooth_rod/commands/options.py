@@ -107,13 +107,17 @@ def build_problem(args):
     return RodProblem.from_geometry(geo, **common)
 
 
-def add_output_options(p: argparse.ArgumentParser, default_out: str = "results") -> None:
-    """--out, --json, --no-plot, --quiet: what every simulating command writes and prints."""
+def add_output_options(p: argparse.ArgumentParser, default_out: str = "results", figure: str = "figure.png",
+                       force: bool = True) -> None:
+    """--out, --json, --no-plot, --quiet (and --force, for the commands that guard their folders):
+    what every simulating command writes and prints."""
     out = p.add_argument_group("output")
     out.add_argument("--out", default=default_out, help=f"output folder (default ./{default_out})")
     out.add_argument("--json", action="store_true", help="print the summary JSON on stdout and nothing else there")
-    out.add_argument("--no-plot", action="store_true", help="do not write figure.png")
+    out.add_argument("--no-plot", action="store_true", help=f"do not write {figure}")
     out.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    if not force:
+        return
     out.add_argument("--force", action="store_true",
                      help="replace the results of another command in --out (`simulate` and `run` refuse to "
                           "overwrite each other's folders without it)")

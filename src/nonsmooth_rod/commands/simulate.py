@@ -102,12 +102,12 @@ def cmd_simulate(args) -> int:
     problem = build_problem(args)
     _check_numerics(args)
     claim_folder(args.out, "simulate", args.force)
+    out_dir = writable_folder(args.out)  # before the run: an unwritable --out is said at once
     extra = {} if args.max_step is None else {"max_step": args.max_step}
     run = simulate(problem, args.method, t_end=args.t_end, h=args.h, solver=args.solver, theta=args.theta,
                    min_phase=args.min_phase, rtol=args.rtol, atol=args.atol, epsilon=args.epsilon,
                    friction_curve=args.friction_curve, ode_method=args.ode_method, stiffness=args.stiffness,
                    damping=args.damping, time_limit=args.time_limit, **extra)
-    out_dir = writable_folder(args.out)
     remove_stale_temps(out_dir)
     summary = dict(run.summary(), provenance=provenance())
     write_csv(out_dir / "trajectory.csv", run.table, TRAJECTORY_COLUMNS)

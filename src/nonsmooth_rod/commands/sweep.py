@@ -31,7 +31,7 @@ map.parquet, sweep.json, map.png (regimes over --map-axes) and, with --refine K,
 (each regime boundary bisected K times between neighbouring grid points). See docs/sweeps.md."""
 
 ROD_DEFAULTS = {"mu_s": "0.05:0.5:46", "theta0_deg": "60", "method": "moreau-jean", "h": 2e-3, "solver": "lemke",
-                "check": 8}
+                "check": 8, "g": 9.81}
 
 RANGE_AXES = (("ball-radius", "ball radius r, m (default 0.020)"),
               ("rod-diameter", "rod diameter d, m (default 0.006)"),
@@ -49,6 +49,7 @@ def register(subparsers) -> None:
                               description=DESCRIPTION, conflict_handler="resolve",
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     add_physics_options(p)
+    p.set_defaults(g=None)  # None: not given (a scene map refuses it); the rod's sweep fills 9.81
     scene = p.add_argument_group("a map of any scene")
     scene.add_argument("scene", nargs="?", default=None, help="scene file (.toml/.json): map it over --axis keys")
     scene.add_argument("--axis", action="append", default=[], metavar="PATH=START:STOP:N",
@@ -226,7 +227,7 @@ def _report(result) -> None:
 
 def _refuse_rod_options(args) -> None:
     rod = [n for n in ROD_DEFAULTS if getattr(args, n) is not None]
-    rod += [n for n in ("mu_d", "mu_d_ratio") if getattr(args, n) is not None]
+    rod += [n for n in ("mu_d", "mu_d_ratio", "mass", "xi", "inertia") if getattr(args, n) is not None]
     rod += [n.replace("-", "_") for n, _ in RANGE_AXES if getattr(args, n.replace("-", "_")) is not None]
     if rod:
         raise InputError(f"--{rod[0].replace('_', '-')} is an option of the rod's sweep; a scene file is "

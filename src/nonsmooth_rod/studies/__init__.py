@@ -11,10 +11,10 @@ def sweep(*args, **kwargs):
 
 
 def fit(*args, **kwargs):
-    from .fit import fit as _fit
+    from .fitting import fit as _fit
 
     return _fit(*args, **kwargs)
 
 
 sweep.__doc__ = "Map outcomes of a scene file over axes of scene keys; see nonsmooth_rod.studies.maps.sweep."
-fit.__doc__ = "Estimate scene keys from measured events and/or a trajectory; see nonsmooth_rod.studies.fit.fit."
+fit.__doc__ = "Estimate scene keys from measured events and/or a trajectory; see nonsmooth_rod.studies.fitting.fit."

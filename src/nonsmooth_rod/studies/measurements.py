@@ -9,16 +9,13 @@ column's standard uncertainty, > 0), then the samples at strictly increasing t."
 from __future__ import annotations
 
 import csv
-import json
-import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..result_files import BODY_QUANTITIES
-from ..validation import InputError
+from ..validation import InputError, require_nonnegative, require_positive
 from .outcome import EVENT_KINDS
 
 
@@ -41,16 +38,12 @@ def trajectory_names(body_names, contact_names) -> list[str]:
         f"{c}.{f}" for c in contact_names for f in ("N", "T")]
 
 
-def _positive(where: str, name: str, value) -> float:
+def _number(where: str, name: str, value, check=require_nonnegative) -> float:
+    """A measured time (≥ 0) or uncertainty (> 0): a number, not a string or a bool."""
     try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{where}: {name} must be a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise InputError(f"{where}: {name} must be finite, got {value!r}")
-    if name == "sigma" and x <= 0:
-        raise InputError(f"{where}: sigma must be > 0, got {x:g}")
-    return x
+        return check(name, value)
+    except InputError as err:
+        raise InputError(f"{where}: {err}") from None
 
 
 def _event(path, i: int, e, contact_names) -> dict:
@@ -66,20 +59,17 @@ def _event(path, i: int, e, contact_names) -> dict:
         raise InputError(f"{where}: kind {e['kind']!r} is not one of {', '.join(EVENT_KINDS)}")
     if e["contact"] not in contact_names:
         raise InputError(f"{where}: no contact named {e['contact']!r} in the scene (have: {', '.join(contact_names)})")
-    t = _positive(where, "t", e["t"])
-    return {"kind": e["kind"], "contact": e["contact"], "t": t, "sigma": _positive(where, "sigma", e["sigma"])}
+    t = _number(where, "t", e["t"])
+    return {"kind": e["kind"], "contact": e["contact"], "t": t,
+            "sigma": _number(where, "sigma", e["sigma"], require_positive)}
 
 
 def read_events(path, contact_names) -> list[dict]:
+    from ..scenefile import read_data
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-        data = json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text)
-    except (OSError, UnicodeDecodeError) as err:
-        raise InputError(f"{path}: cannot read ({getattr(err, 'strerror', None) or err})") from None
-    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as err:
-        raise InputError(f"{path}: not valid {'JSON' if path.suffix.lower() == '.json' else 'TOML'}: {err}") from None
-    if not isinstance(data, dict) or set(data) - {"events"} or not isinstance(data.get("events"), list):
+    data, _ = read_data(path, "measured events")
+    if set(data) - {"events"} or not isinstance(data.get("events"), list):
         raise InputError(f"{path}: expected only [[events]] tables (kind, contact, t, sigma)")
     events = [_event(path, i, e, contact_names) for i, e in enumerate(data["events"])]
     if not events:
