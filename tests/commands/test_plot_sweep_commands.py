@@ -217,7 +217,7 @@ def test_sweep_on_a_full_disk_ends_in_one_line_and_resumes(tmp_path, capsys, mon
     import builtins
     import errno
 
-    from nonsmooth_rod.rod import regime
+    from nonsmooth_rod.studies import runner
 
     clean, out = tmp_path / "clean", tmp_path / "full"
     assert main(SMALL_SWEEP + ["--jobs", "1", "--out", str(clean)]) == 0
@@ -246,7 +246,7 @@ def test_sweep_on_a_full_disk_ends_in_one_line_and_resumes(tmp_path, capsys, mon
         fh = real_open(path, mode, *args, **kwargs)
         return FillingDisk(fh) if str(path).endswith("regime_map.csv") and "a" in mode else fh
 
-    monkeypatch.setattr(regime, "open", open_on_a_full_disk, raising=False)
+    monkeypatch.setattr(runner, "open", open_on_a_full_disk, raising=False)  # the sweeps' row sink
     assert main(SMALL_SWEEP + ["--jobs", "1", "--out", str(out)]) == 1
     assert _one_line(capsys) == f"nonsmooth-rod: cannot write {out / 'regime_map.csv'}: No space left on device"
     assert len(read_csv(out / "regime_map.csv")["mu_s"]) == 3

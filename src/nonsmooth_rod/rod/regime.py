@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _jit
-from ..io import dumps_json, output_error, provenance, remove_stale_temps, write_csv, write_json
+from ..io import dumps_json, provenance, remove_stale_temps, write_csv, write_json
 from ..studies import runner
 from ..validation import InputError
 from .problem import RodProblem
@@ -237,19 +237,10 @@ def sweep(base: RodProblem, grid: Grid, out_dir, settings: SweepSettings = Sweep
     remove_stale_temps(out_dir)
     opts = dict(progress=progress, plot=plot, formats=formats, dpi=dpi, check_points=check_points,
                 map_axes=tuple(map_axes), command=command)
-    with folder_lock(out_dir):
-        if executor is not None and not isinstance(executor, str):
-            return _sweep(base, grid, out_dir, settings, executor, jobs, **opts)
-        from ..executors import WorkerLost, open_executor
-
-        if executor in (None, "local"):
-            warm_engine(settings)  # before forking: the workers inherit the loaded engine
-        try:
-            with open_executor(executor or "local", jobs, scheduler) as (pool, workers):
-                return _sweep(base, grid, out_dir, settings, pool, workers, **opts)
-        except WorkerLost as err:
-            raise WorkerLost(f"{err}: the sweep stopped; the points finished are kept in {out_dir / CSV_NAME}: "
-                             "run the same sweep again to resume") from None
+    if executor in (None, "local"):
+        warm_engine(settings)  # before forking: the workers inherit the loaded engine
+    with folder_lock(out_dir), runner.executor_pool(executor, jobs, scheduler, out_dir / CSV_NAME) as (pool, workers):
+        return _sweep(base, grid, out_dir, settings, pool, workers, **opts)
 
 
 def _run_points(base, settings, columns, todo, pool, workers, on_rows, meanwhile=None) -> None:
@@ -274,17 +265,9 @@ def _sweep(base, grid, out_dir, settings, pool, workers, *, progress, plot, form
     todo = [pt for pt in points if point_key(pt) not in done]
     new_rows: list[dict] = []
     csv_path = out_dir / CSV_NAME
-    with open(csv_path, "a", newline="", encoding="utf-8") as sink, runner.progress(progress, len(points)) as bar:
+    with runner.progress(progress, len(points)) as bar, \
+            runner.row_sink(csv_path, columns, bar, new_rows) as record_rows:
         bar.advance(len(points) - len(todo))
-
-        def record_rows(rows):
-            try:
-                sink.write(runner.row_lines(rows, columns))
-                sink.flush()  # a row on disk is a row an interrupted sweep need not redo
-            except OSError as err:  # a full disk: the rows already written stay, resume redoes the rest
-                raise output_error(csv_path, err) from None
-            new_rows.extend(rows)
-            bar.advance(len(rows))
 
         side: dict = {}
 

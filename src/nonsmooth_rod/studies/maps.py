@@ -186,18 +186,9 @@ def sweep(scene, axes, out_dir, *, sets=(), outcomes=None, refine: int = 0, jobs
     out_dir.mkdir(parents=True, exist_ok=True)
     remove_stale_temps(out_dir)
     job = _Job(data, source, axes, paths, names, columns, out_dir, refine, progress, command)
-    with runner.folder_lock(out_dir):
-        if executor is not None and not isinstance(executor, str):
-            result = job.run(executor, jobs)
-        else:
-            from ..executors import WorkerLost, open_executor
-
-            try:
-                with open_executor(executor or "local", jobs, scheduler) as (pool, workers):
-                    result = job.run(pool, workers)
-            except WorkerLost as err:
-                raise WorkerLost(f"{err}: the sweep stopped; the points finished are kept in {out_dir / CSV_NAME}: "
-                                 "run the same sweep again to resume") from None
+    with runner.folder_lock(out_dir), runner.executor_pool(executor, jobs, scheduler, out_dir / CSV_NAME) as \
+            (pool, workers):
+        result = job.run(pool, workers)
     if plot:
         from .map_figure import map_figure, save
 
@@ -257,19 +248,11 @@ class _Job:
         done = {runner.row_key(r, self.paths) for r in earlier}
         points = _grid_points(self.axes)
         todo = [p for p in points if runner.point_key(p) not in done]
-        with open(self.out_dir / CSV_NAME, "a", newline="", encoding="utf-8") as sink, \
-                runner.progress(self.progress, len(points)) as bar:
+        new: list[dict] = []
+        with runner.progress(self.progress, len(points)) as bar, \
+                runner.row_sink(self.out_dir / CSV_NAME, self.columns, bar, new) as record_rows:
             bar.advance(len(points) - len(todo))
-
-            def record_rows(rows):
-                try:
-                    sink.write(runner.row_lines(rows, self.columns))
-                    sink.flush()  # a row on disk is a row an interrupted sweep need not redo
-                except OSError as err:  # a full disk: the rows written stay, a resume redoes the rest
-                    raise output_error(self.out_dir / CSV_NAME, err) from None
-                bar.advance(len(rows))
-
-            new = self.points(pool, workers, todo, record_rows)
+            self.points(pool, workers, todo, record_rows)
         compute_s = time.perf_counter() - started
         every = runner.sorted_unique(earlier + new, self.paths)
         runner.write_table(self.out_dir / CSV_NAME, every, self.columns, self.paths)

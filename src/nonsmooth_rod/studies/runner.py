@@ -250,6 +250,41 @@ if hasattr(os, "register_at_fork"):
 
 
 # --------------------------------------------------------------------------- running points
+@contextlib.contextmanager
+def executor_pool(executor, jobs: int, scheduler, csv_path: Path):
+    """(pool, workers) for a sweep's `executor`: one given by the caller is used as is (not shut
+    down here; `jobs` sizes the chunks); None/"local" and "dask" are opened and closed here. A
+    lost worker stops the sweep with where its finished points are kept."""
+    if executor is not None and not isinstance(executor, str):
+        yield executor, jobs
+        return
+    from ..executors import WorkerLost, open_executor
+
+    try:
+        with open_executor(executor or "local", jobs, scheduler) as (pool, workers):
+            yield pool, workers
+    except WorkerLost as err:
+        raise WorkerLost(f"{err}: the sweep stopped; the points finished are kept in {csv_path}: "
+                         "run the same sweep again to resume") from None
+
+
+@contextlib.contextmanager
+def row_sink(csv_path: Path, columns, bar, collected: list):
+    """`record_rows(rows)`: append finished rows to the sweep's CSV as they arrive (a row on disk
+    is a row an interrupted sweep need not redo), keep them in `collected`, advance the bar."""
+    with open(csv_path, "a", newline="", encoding="utf-8") as sink:
+        def record_rows(rows):
+            try:
+                sink.write(row_lines(rows, columns))
+                sink.flush()
+            except OSError as err:  # a full disk: the rows written stay, a resume redoes the rest
+                raise output_error(csv_path, err) from None
+            collected.extend(rows)
+            bar.advance(len(rows))
+
+        yield record_rows
+
+
 def run_chunked(task, args: tuple, todo, pool, workers, on_rows, meanwhile=None) -> None:
     """Run `task(*args, chunk) → rows` over `todo`: in this process (pool None, one point per
     call) or in chunks on `pool`; `on_rows` gets each finished chunk's rows as they arrive.
