@@ -187,10 +187,10 @@ class Coordinates:
 
 
 # --------------------------------------------------------------------------- the estimate's quality
-def jacobian(model: Model, p: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+def jacobian(model: Model, p: np.ndarray, sigma: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:
     """d(residual)/d(key) at p, residuals in sigmas: central differences, one-sided at a bound
-    or where the scene refuses a side (μd above μs)."""
-    base = model.predict(p)
+    or where the scene refuses a side (μd above μs). `base`: the prediction at p, if known."""
+    base = model.predict(p) if base is None else base
     J = np.zeros((base.size, p.size))
     for i, f in enumerate(model.free):
         h = REL_STEP * f.scale
@@ -353,9 +353,9 @@ def fit(scene, measured, free, *, sets=(), method: str | None = None, max_evalua
     sol = least_squares(residuals, z0, bounds=(lo, hi), method="trf", diff_step=REL_STEP, x_scale="jac",
                         xtol=1e-7, max_nfev=max_evaluations)
     p = coords.physical(sol.x)
-    J = jacobian(model, p, sig)
+    fitted = obs + sig * sol.fun  # the residuals at the solution: no second run of the same point
+    J = jacobian(model, p, sig, fitted)
     sd, corr, verdicts = identifiability(J, frees)
-    fitted = model.predict(p)
     chi2 = float(np.sum(((fitted - obs) / sig) ** 2))
     return FitResult([f.path for f in frees], p, sd, corr, verdicts, [(f.lo, f.hi) for f in frees], model.labels,
                      obs, sig, fitted, method, chi2, bool(sol.success), str(sol.message), model.calls, m,
