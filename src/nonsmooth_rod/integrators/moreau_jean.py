@@ -61,6 +61,9 @@ class MoreauJeanOptions:
     min_phase: float | None = option(None, Number(0.0, optional=True))  # shorter phases are merged (default 2h)
     allow_energy_gain: bool = option(False, Flag())  # θ < ½ amplifies energy; refused unless asked for
     fast: bool = option(True, Flag())  # use the compiled loop when the scene and solver allow it
+    # repeat an exact rest (a fixed point of the step) instead of solving it again: the same run
+    # bit for bit, in a fraction of the time (docs/performance.md); off to time the steps themselves
+    repeat_rest: bool = option(True, Flag())
 
     def __post_init__(self):
         check_options(self)
@@ -205,7 +208,7 @@ class MoreauJean:
         window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume)
-        params, iparams = self._parameters(grid, names)
+        params, iparams = self._parameters(scene, grid, names)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         engine = Engine(bool(opts.fast and _jit.ENABLED),
                         *compiled_part(opts.solver, solver_code, scene.applied_force is not None))
@@ -219,7 +222,7 @@ class MoreauJean:
                  "force_callback": scene.applied_force is not None}
         return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
 
-    def _parameters(self, grid, names):
+    def _parameters(self, scene, grid, names):
         opts = self.options
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         solver_options = dict(opts.solver_options)
@@ -229,8 +232,8 @@ class MoreauJean:
         params[loop.P_T0], params[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
         iparams = np.array([-1 if solver_code is None else solver_code,
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
-                            names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1],
-                           dtype=np.int64)
+                            names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1,
+                            int(opts.repeat_rest and not scene.forces_vary_in_time())], dtype=np.int64)
         return params, iparams
 
     def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops):
@@ -407,7 +410,8 @@ class MoreauJean:
         stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
                      solver_iterations=int(counters[loop.K_ITERATIONS]),
                      inconsistent_steps=int(counters[loop.K_INCONSISTENT]),
-                     solver_fallbacks=int(counters[loop.K_FALLBACKS]))
+                     solver_fallbacks=int(counters[loop.K_FALLBACKS]),
+                     steps_at_rest=int(counters[loop.K_REPEATED]))
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, events,
                                   impacts, phases, steps=n_done, cpu_time_s=cpu, stats=stats)
         on_grid = k_end < grid.last or not grid.h_last

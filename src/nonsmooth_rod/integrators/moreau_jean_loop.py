@@ -62,15 +62,20 @@ RUN_OK, RUN_SOLVER_FAILED, RUN_NONFINITE, RUN_STOPPED, RUN_BAD_GEOMETRY = 0, 1, 
 RUN_STOPPED_BY_CONDITION = 5
 # Slots of the int64 `counters` record.
 (K_DONE, K_STATUS, K_FAIL_STEP, K_N_IMPACTS, K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_SOLVER_STATUS,
- K_FAIL_CONTACT, K_FALLBACKS) = range(10)
-N_COUNTERS = 10
+ K_FAIL_CONTACT, K_FALLBACKS, K_REPEATED) = range(11)
+N_COUNTERS = 11
+# The solver's work counters a repeated step adds again (_repeat_period).
+REPEATED_COUNTERS = (K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_FALLBACKS)
 # Float parameters: h, θ, γ (activation), the time origin t0, solver rtol, and the step index
 # of row 0 of the out arrays (a run goes in windows of rows: a step's time is t0 + (k0 + k) h
 # whichever window or restart it falls in, so a restarted run repeats the very same floats).
-# Int parameters: solver code, max iterations, stop contact (−1: none).
+# Int parameters: solver code, max iterations, stop contact (−1: none), and whether the step
+# map is the same at every time (no force or obstacle that changes with t alone: a state the
+# step leaves unchanged is then kept for the rest of the window without solving — _run).
 P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0, P_H_GRID = range(7)
 N_PARAMS = 7
-I_SOLVER, I_MAX_ITER, I_STOP = range(3)
+I_SOLVER, I_MAX_ITER, I_STOP, I_TIME_INVARIANT = range(4)
+N_IPARAMS = 4
 
 
 @jit
@@ -491,11 +496,85 @@ def end_of_step(k, status, counters):
 def _run(solver_code, k_start, k_end, params, iparams, model, work, out):
     """Steps k_start … k_end − 1 with the packed forces: the whole run in one call."""
     f = np.empty(model[0].shape[0])
-    for k in range(k_start, k_end):
+    counters = out[9]
+    # The contacts' memory after each of the last three steps and the solver's counters before
+    # them (a ring by step): what _fixed_period compares.
+    memory = np.empty((3, 3, model[2].shape[0]))
+    before = np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64)
+    k = k_start
+    while k < k_end:
+        for c in range(len(REPEATED_COUNTERS)):
+            before[k % 3, c] = counters[REPEATED_COUNTERS[c]]
         step_force(k, params, model, out, f)
-        if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out), out[9]) != RUN_OK:
-            return out[9][K_STATUS]
+        if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out), counters) != RUN_OK:
+            return counters[K_STATUS]
+        for i in range(memory.shape[2]):
+            memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = work[5][i], work[6][i], work[7][i]
+        period = _fixed_period(k, k - k_start + 1, out, memory) if iparams[I_TIME_INVARIANT] and k + 1 < k_end else 0
+        if period > 0:
+            k = _repeat_period(k, k_end, period, out, work, memory, before)
+        k += 1
     return RUN_OK
+
+
+@jit
+def _fixed_period(k, steps_here, out, memory):
+    """1 or 2 when the state step k leaves — q, v, the contacts' memory and the impulses the next
+    step warm-starts from — is the one left by step k − 1 (a rest) or k − 2 (a two-step cycle of
+    round-off, as a held body's v alternating between two values of 1e-18); else 0.
+
+    The step map is a function of that state, the same at every t when iparams[I_TIME_INVARIANT]
+    (no force that changes with time alone): every later step then repeats one of the last
+    `period` steps bit for bit. Exact holds (no creep) reach such a state within a few steps."""
+    q, v, p_normal, p_tangent = out[0], out[1], out[2], out[3]
+    for period in range(1, 3):
+        if steps_here <= period:
+            return 0
+        same = True
+        for d in range(q.shape[1]):
+            if q[k + 1, d] != q[k + 1 - period, d] or v[k + 1, d] != v[k + 1 - period, d]:
+                same = False
+                break
+        for i in range(p_normal.shape[1] if same else 0):
+            if p_normal[k, i] != p_normal[k - period, i] or p_tangent[k, i] != p_tangent[k - period, i]:
+                same = False
+                break
+            for m in range(3):
+                if memory[k % 3, m, i] != memory[(k - period) % 3, m, i]:
+                    same = False
+            if not same:
+                break
+        if same:
+            return period
+    return 0
+
+
+@jit
+def _repeat_period(k, k_end, period, out, work, memory, before):
+    """Rows k + 1 … k_end − 1 as the step `period` rows before each made them (state, records,
+    the solver's counters, the memory left at the end); returns the last step so filled."""
+    counters = out[9]
+    for r in range(k + 1, k_end):
+        out[0][r + 1, :] = out[0][r + 1 - period]
+        out[1][r + 1, :] = out[1][r + 1 - period]
+        out[2][r, :] = out[2][r - period]  # impulses, slips, states (a tuple: literal indices)
+        out[3][r, :] = out[3][r - period]
+        out[4][r, :] = out[4][r - period]
+        out[5][r, :] = out[5][r - period]
+    for c in range(len(REPEATED_COUNTERS)):
+        added = 0
+        for j in range(k + 1 - period, k + 1):  # each repeated step adds what its original added
+            after = counters[REPEATED_COUNTERS[c]] if j == k else before[(j + 1) % 3, c]
+            n = (k_end - 1 - j) // period  # the later steps j + period, j + 2 period, ... < k_end
+            added += n * (after - before[j % 3, c])
+        counters[REPEATED_COUNTERS[c]] += added
+    last = k_end - 1
+    src = k - ((k - last) % period)  # the step of the last period that `last` repeats
+    for i in range(memory.shape[2]):  # the memory the last filled step leaves: its original's
+        work[5][i], work[6][i], work[7][i] = memory[src % 3, 0, i], memory[src % 3, 1, i], memory[src % 3, 2, i]
+    counters[K_REPEATED] += last - k
+    counters[K_DONE] = k_end
+    return last
 
 
 # One compiled entry for every solver, which reads its code from iparams at run time: the three
