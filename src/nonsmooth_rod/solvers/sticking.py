@@ -434,7 +434,8 @@ def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p
     candidate is tried held with the others free (MODE_FREE, MODE_LOOSE: a relaxation of every
     mode that holds it; one that fails is in no held set and is dropped); then `held_set`: the
     largest admissible S if it is the only one of its size, else the search goes on below the tied
-    sets' intersection — never contact order. At most MAX_TRIALS tries. Beyond MAX_CANDIDATES
+    sets' intersection — never contact order. At most MAX_TRIALS tries. No moving candidate left by the
+    pruning: every held set is within the solver's own, whose answer stands without a search. Beyond MAX_CANDIDATES
     candidates (a large pile) only the sliding ones are searched (order-dependent, but no LPs on
     the whole group in every step where a contact lifts).
     """
@@ -459,15 +460,13 @@ def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p
                  scale, p_start, p_new):
         _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
         return True
-    if n_c > 1:  # pruning: each candidate alone, with the other candidates free (one the solver
-        kept = 0  # holds needs no test: its answer is a split of the relaxation)
-        for c in range(n_c):
-            _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
-            if states[candidates[c]] == STATE_STICK or _admissible_either(
-                    W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-                candidates[kept], release[kept] = candidates[c], release[c]
-                kept += 1
-        n_c = min(kept, MAX_CANDIDATES)
+    if n_c == 1:  # the one candidate cannot be held: the only other set, none, is the solver's own
+        return False
+    kept = _prune(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+                  scale, p_new)
+    if _sticking_mask(candidates, kept, states) == (1 << kept) - 1:
+        return False  # no moving candidate can be held: every held set is within the solver's own
+    n_c = min(kept, MAX_CANDIDATES)
     held = held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
                     velocity_tol, scale, p_new)
     if held < 0 or held == _sticking_mask(candidates, n_c, states):
@@ -488,6 +487,22 @@ def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, st
         p_new[:] = p_start
         return True
     return _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+
+
+@jit
+def _prune(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol, scale,
+           p_new):
+    """Keep (moved to the front of candidates, release) the candidates that can be held with the
+    other candidates free, and return how many: one the solver holds needs no test (its answer is
+    a split of the relaxation); each other costs one LP."""
+    kept = 0
+    for c in range(n_c):
+        _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
+        if states[candidates[c]] == STATE_STICK or _admissible_either(
+                W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+            candidates[kept], release[kept] = candidates[c], release[c]
+            kept += 1
+    return kept
 
 
 @jit
