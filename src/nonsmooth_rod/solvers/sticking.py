@@ -238,10 +238,29 @@ def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
 
 
 @jit
+def _fixed_split_margin(h, weight):
+    """_deepest_split with no unknown z, in closed form: t = min(1, h_r / weight_r over the
+    weighted rows), or −inf when a hard row (weight 0) is violated beyond simplex_max's phase-1
+    tolerance 1e-10 (1 + max(|h|, 1)) — the optimum the simplex finds, without its tableau."""
+    scale = 1.0
+    for r in range(h.shape[0]):
+        scale = max(scale, abs(h[r]))
+    t = 1.0
+    for r in range(h.shape[0]):
+        if weight[r] > 0.0:
+            t = min(t, h[r] / weight[r])
+        elif h[r] < -1e-10 * (1.0 + scale):
+            return -np.inf
+    return t
+
+
+@jit
 def _deepest_split(G, h, weight, z):
     """max t subject to g0 + g·z ≥ weight·t, |z| ≤ SPLIT_BOUND, t ≤ 1 (z, t free; scaled units).
     Fills z and returns t (−inf when even the hard rows cannot hold)."""
     m, k = G.shape
+    if k == 0:  # the mode fixes the split (a row of balls): no simplex (~0.6 ms on 54 rows)
+        return _fixed_split_margin(h, weight)
     n = 2 * k + 2  # z = z⁺ − z⁻, t = t⁺ − t⁻
     Glp = np.zeros((m + 2 * k + 1, n))
     hlp = np.zeros(m + 2 * k + 1)
