@@ -35,8 +35,9 @@ def _ladder():
 SCENES = {
     "pyramid": _pyramid,
     "ladder": _ladder,
-    "pile of six short of friction": lambda: disk_pile(3, law=ContactLaw.of(0.3, 0.2, 0.0)),
-    "pile of six that holds": lambda: disk_pile(3),
+    # without walls: friction alone holds the bottom row (or does not)
+    "pile of six short of friction": lambda: disk_pile(3, law=ContactLaw.of(0.3, 0.2, 0.0), walls=False),
+    "pile of six that holds": lambda: disk_pile(3, walls=False),
     "row of four balls": lambda: ball_row(4),
 }
 # enumeration takes groups of at most four contacts

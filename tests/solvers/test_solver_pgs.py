@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from nonsmooth_rod.solvers.gauss_seidel import projected_gauss_seidel, solve_contact
+from nonsmooth_rod.solvers import solve
+from nonsmooth_rod.solvers.gauss_seidel import dense_to_blocks, pgs_sweep, projected_gauss_seidel, solve_contact
 from nonsmooth_rod.solvers.problem import (
     NoConvergence,
     PlanarFrictionProblem,
@@ -138,3 +139,49 @@ def test_explicit_tolerance_on_a_step_with_no_exact_solution_raises():
         projected_gauss_seidel(problem, tol=1e-9, max_iter=200)
     with pytest.raises(NoConvergence):  # nor under the defaults: ε/2 is far above their acceptance
         projected_gauss_seidel(problem)
+
+
+def _diagonal(indptr, indices):
+    return np.array([k for i in range(indptr.shape[0] - 1) for k in range(indptr[i], indptr[i + 1])
+                     if indices[k] == i])
+
+
+def _pushed_chain(n_balls: int, radius=0.05, mass=0.1, h=1e-3):
+    """n balls touching in a row on a floor, the first pushed at 1 m/s into the others (frictionless
+    between the balls, μ 0.3 on the floor): a chain of coupled contacts, block-sparse."""
+    inverse_mass = np.diag([1 / mass, 1 / mass, 1 / (0.4 * mass * radius**2)])
+    parts = []
+    for i in range(n_balls):
+        parts.append([(i, np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, -radius]]))])  # floor: normal +y
+        if i + 1 < n_balls:  # ball i+1 on ball i: normal +x
+            parts.append([(i + 1, np.array([[1.0, 0.0, 0.0], [0.0, 1.0, -radius]])),
+                          (i, np.array([[-1.0, 0.0, 0.0], [0.0, -1.0, -radius]]))])
+    H_rows = np.zeros((2 * len(parts), 3 * n_balls))
+    for c, contact in enumerate(parts):
+        for body, G in contact:
+            H_rows[2 * c: 2 * c + 2, 3 * body: 3 * body + 3] = G
+    W = H_rows @ np.kron(np.eye(n_balls), inverse_mass) @ H_rows.T
+    v = np.zeros(3 * n_balls)
+    v[0], v[1::3] = 1.0, -9.81 * h
+    mu = np.array([0.3 if len(contact) == 1 else 0.0 for contact in parts])
+    return PlanarFrictionProblem(W, H_rows @ v, -mu, mu)
+
+
+def test_the_mode_polish_finishes_a_pushed_chain_in_few_sweeps():
+    """Gauss–Seidel alone converges like on a discrete Laplacian (hundreds of sweeps for a chain
+    of 12); the polish solves the mode the iterate shows exactly at sweep 4, 8, 16, …, and what
+    it returns meets the same residual as the sweeps (issue 26)."""
+    from nonsmooth_rod.solvers.gauss_seidel import POLISH_FIRST
+    problem = _pushed_chain(12)
+    indptr, indices, blocks = dense_to_blocks(problem.W)
+    p = np.zeros(problem.q.shape[0])
+    for _ in range(100):  # the sweeps alone
+        pgs_sweep(indptr, indices, blocks, _diagonal(indptr, indices),
+                  problem.q, problem.lo, problem.hi, p)
+    assert complementarity_residual(problem, p) > 1e-6 * residual_scale(problem, p, problem.W @ p + problem.q)
+    solution = projected_gauss_seidel(problem)
+    assert solution.iterations in [POLISH_FIRST * 2**k for k in range(6)]
+    scale = residual_scale(problem, solution.p, solution.u)
+    assert complementarity_residual(problem, solution.p) <= 1e-12 * scale
+    lemke = solve(problem, "lemke")  # the same velocities as Lemke's pivoting
+    np.testing.assert_allclose(solution.u, lemke.u, rtol=0, atol=1e-10 * scale)

@@ -355,3 +355,26 @@ def test_a_previous_split_that_still_holds_is_reused_and_one_that_does_not_is_no
     p, u, states = _free_fall(q)
     assert prefer_sticking_from(W, q, mu_s, mu_d, np.zeros(2), tol, np.zeros(2), p, u, states, moving)
     np.testing.assert_array_equal(p, held)  # the LP's split again
+
+
+def test_the_split_margin_without_unknowns_is_the_simplex_optimum():
+    """_deepest_split with no null-space unknown (a mode that fixes the split) skips the simplex:
+    its closed form max t s.t. weight·t ≤ h, t ≤ 1 (−inf for a violated hard row) agrees with
+    simplex_max on the same LP to round-off (issue 26)."""
+    from nonsmooth_rod.solvers.sticking import _fixed_split_margin
+    rng = np.random.default_rng(26)
+    infeasible = 0
+    for _ in range(300):
+        m = int(rng.integers(1, 20))
+        h = rng.normal(size=m)
+        weight = (rng.random(m) < 0.6).astype(float)
+        G = np.vstack([np.c_[weight, -weight], [[1.0, -1.0]]])  # t = t⁺ − t⁻
+        x = np.zeros(2)
+        status = simplex_max(np.array([1.0, -1.0]), G, np.r_[h, 1.0], x)
+        closed = _fixed_split_margin(h, weight)
+        if status != 0:
+            assert closed == -np.inf
+            infeasible += 1
+        else:
+            assert closed == pytest.approx(x[0] - x[1], rel=1e-12, abs=1e-12)
+    assert 0 < infeasible < 300

@@ -23,6 +23,17 @@ solver uses (DEFAULT_RTOL, as Lemke's and enum's), they stop there and the answe
 its range (two contacts on one body, gap-keeping terms), the exact solution has a slip
 velocity of ~1e-11 that Gauss–Seidel approaches by a drift along W's null space, 1e9 sweeps
 away (the rod at ball B's impact, issue 9). With one contact the first sweep is exact.
+
+Mode polish (issue 26). On a chain of touching bodies (a row of balls pushed together) the
+sweeps converge like Gauss–Seidel on a discrete Laplacian, 1 − O(1/k²) per sweep for k contacts
+in a chain: hundreds of sweeps, although the mode (which contacts are open, stick, slide which
+way) is right after a few. So at sweeps POLISH_FIRST, 2·POLISH_FIRST, 4·POLISH_FIRST, … each
+coupled group of at most POLISH_MAX_GROUP contacts whose own residual is still above the target
+has the linear equations of the mode its iterate shows solved exactly (`solve_mode`: least
+squares, minimum norm — a singular W gets its least-norm split), and the result is kept only if
+the whole problem then meets the target on the same residual; otherwise the sweeps go on from
+where they were. The stopping rule is unchanged: whatever is returned as solved has
+complementarity_residual ≤ rtol · scale (or, stalled, ≤ DEFAULT_RTOL · scale).
 """
 from __future__ import annotations
 
@@ -41,6 +52,7 @@ from .kernel_base import (
     problem_scale,
 )
 from .problem import NoConvergence, PlanarFrictionProblem
+from .sticking import coupled_components, gather_contacts, group_matrix
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
 # corner contact of a body with rotational inertia never gets there, but e.g. a contact on
@@ -55,6 +67,11 @@ PGS_MAX_SWEEPS = 10000
 # A linear rate that slow (ρ > 0.9998) would need > 3·10⁴ sweeps per factor 10³ anyway.
 STALL_SWEEPS = 50
 STALL_FACTOR = 0.99
+# Mode polish (module docstring): first at this sweep, then at every doubling; groups of at most
+# this many contacts (its least squares costs O(contacts³): a pile's cold first step of 94
+# contacts is cheaper swept).
+POLISH_FIRST = 4
+POLISH_MAX_GROUP = 48
 
 
 @jit
@@ -193,6 +210,7 @@ def pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps):
     limit = max_sweeps if max_sweeps > 0 else PGS_MAX_SWEEPS
     history = np.full(STALL_SWEEPS, np.inf)
     residual = np.inf
+    polish_at = POLISH_FIRST
     for sweep in range(1, limit + 1):
         pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p)
         block_velocities(indptr, indices, blocks, q, p, u)
@@ -200,12 +218,93 @@ def pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps):
         scale = problem_scale(q, p, u)
         if residual <= target * scale + 1e-300:
             return KERNEL_SOLVED, sweep, residual
+        if sweep == polish_at:
+            polish_at *= 2
+            if polish_modes(indptr, indices, blocks, q, lo, hi, p, u, target):
+                return KERNEL_SOLVED, sweep, contact_residual(lo, hi, p, u)
         slot = sweep % STALL_SWEEPS
         stalled = residual > STALL_FACTOR * history[slot]
         history[slot] = residual
         if stalled and residual <= accept * scale:
             return KERNEL_SOLVED, sweep, residual
     return KERNEL_NO_CONVERGENCE, limit, residual
+
+
+@jit
+def solve_mode(W, q, lo, hi, p, u):
+    """Replace p, u (one group, dense W) by the exact solution of the mode p shows: a contact with
+    p_N > 0 touches (u_N = 0) and sticks (u_T = 0) if p_T is strictly inside its interval, else
+    slides at that end (p_T = end · p_N); the others carry nothing. Least squares, minimum norm.
+    False when nothing is closed or the answer is not finite (p, u then unchanged)."""
+    n = lo.shape[0]
+    P = np.zeros((2 * n, 2 * n))
+    rows = np.empty(2 * n, dtype=np.int64)
+    k, r = 0, 0
+    for i in range(n):
+        p_n, p_t = p[2 * i], p[2 * i + 1]
+        if p_n <= 0.0:
+            continue
+        P[2 * i, k] = 1.0
+        rows[r] = 2 * i
+        r += 1
+        if p_t <= lo[i] * p_n or p_t >= hi[i] * p_n:
+            P[2 * i + 1, k] = lo[i] if p_t <= lo[i] * p_n else hi[i]
+            k += 1
+            continue
+        P[2 * i + 1, k + 1] = 1.0
+        rows[r] = 2 * i + 1
+        r += 1
+        k += 2
+    if k == 0:
+        return False
+    P = np.ascontiguousarray(P[:, :k])
+    WP = W @ P
+    A = np.empty((r, k))
+    b = np.empty(r)
+    for j in range(r):
+        A[j, :] = WP[rows[j], :]
+        b[j] = -q[rows[j]]
+    x = np.linalg.lstsq(A, b)[0]
+    p_new = P @ x
+    if not all_finite(p_new):
+        return False
+    p[:] = p_new
+    u[:] = W @ p_new + q
+    return True
+
+
+@jit
+def polish_modes(indptr, indices, blocks, q, lo, hi, p, u, rtol):
+    """solve_mode on every coupled group of at most POLISH_MAX_GROUP contacts whose residual is
+    above rtol × the problem's scale; kept (p, u replaced, True) only when the whole problem's
+    residual is then within rtol × its scale, else p, u unchanged and False."""
+    na = lo.shape[0]
+    tolerance = rtol * problem_scale(q, p, u) + 1e-300
+    label = np.empty(na, dtype=np.int64)
+    groups = coupled_components(indptr, indices, np.zeros((0, 0)), label)
+    p_new, changed = p.copy(), False
+    for g in range(groups):
+        members = np.flatnonzero(label == g)
+        if members.shape[0] > POLISH_MAX_GROUP:
+            continue
+        lo_g, hi_g = gather_contacts(members, lo, False), gather_contacts(members, hi, False)
+        p_g, u_g = gather_contacts(members, p, True), gather_contacts(members, u, True)
+        if contact_residual(lo_g, hi_g, p_g, u_g) <= tolerance:
+            continue
+        if solve_mode(group_matrix(members, np.zeros((0, 0)), indptr, indices, blocks),
+                      gather_contacts(members, q, True), lo_g, hi_g, p_g, u_g):
+            for a in range(members.shape[0]):
+                p_new[2 * members[a]], p_new[2 * members[a] + 1] = p_g[2 * a], p_g[2 * a + 1]
+            changed = True
+    if not changed:
+        return False
+    u_new = np.empty_like(u)
+    block_velocities(indptr, indices, blocks, q, p_new, u_new)
+    if contact_residual(lo, hi, p_new, u_new) > rtol * problem_scale(q, p_new, u_new) + 1e-300:
+        return False
+    p[:] = p_new
+    u[:] = u_new
+    return True
 
 
 @jit
@@ -258,5 +357,5 @@ def projected_gauss_seidel(
 
 __all__ = [
     "projected_gauss_seidel", "solve_contact", "local_contact_solve", "pgs_block", "pgs_dense",
-    "dense_to_blocks", "block_velocities",
+    "dense_to_blocks", "block_velocities", "solve_mode", "polish_modes",
 ]

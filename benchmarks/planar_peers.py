@@ -1,0 +1,159 @@
+"""The rows and piles of `toys/stacks.py` stepped by other engines, planar where the engine allows,
+timed as ours (process time per step, median of repeats). Each peer is optional: install them in
+a separate virtual environment, not in the project's dependencies::
+
+    python3 -m venv /work/bench-venv --system-site-packages
+    /work/bench-venv/bin/pip install mujoco pybullet pymunk
+
+Every peer gets the same geometry (balls of radius R, mass m, inertia 0.4 m R²), the same
+friction coefficient (one μ: their laws have no μs/μd — our μs is given), restitution 0, gravity
+9.81, h and initial state, and finds its contacts itself (as ours declares every pair and lets
+its broad phase drop those out of reach). Their settings, stated so the comparison is fair both
+ways (`PEER_SETTINGS`):
+
+* MuJoCo: planar — each ball a body with slide x, slide z and hinge y joints; spheres on a plane
+  floor, plane walls; default solver (Newton, 100 iterations, tolerance 1e-8), pyramidal cone,
+  condim 3, soft contacts (solref 0.02 1: the default), `mj_step`.
+* PyBullet: 3-D spheres on a plane with box walls (no planar constraint: the scene stays in its
+  plane by symmetry), default solver (sequential impulses, 50 iterations, ERP), `stepSimulation`.
+* pymunk (Chipmunk2D): planar, circles on static segments, `space.iterations` 10 (default) and
+  100, friction √μ per shape (Chipmunk multiplies the two shapes'), `space.step(h)`.
+
+None of them solves the exact two-coefficient law, and MuJoCo and PyBullet are soft-contact
+engines (a resting pile sinks into its floor by their penetration allowance): the comparison is
+of cost only.
+"""
+from __future__ import annotations
+
+import math
+import statistics
+import time
+
+PEER_SETTINGS = {
+    "mujoco": "planar (slide x, slide z, hinge y); Newton solver, 100 iterations, tol 1e-8, pyramidal cone, "
+              "condim 3, default solref/solimp",
+    "bullet": "3-D spheres, box walls, DIRECT mode; default SI solver, 50 iterations",
+    "pymunk10": "Chipmunk2D, space.iterations = 10 (default), friction sqrt(mu) per shape",
+    "pymunk100": "Chipmunk2D, space.iterations = 100",
+}
+
+
+def _median_step_us(step, reset, steps: int, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        reset()
+        t0 = time.process_time()
+        for _ in range(steps):
+            step()
+        times.append((time.process_time() - t0) / steps * 1e6)
+    return statistics.median(times)
+
+
+def mujoco_planar_step_us(scene, h, steps, repeats):
+    """mj_step per step on the planar model, or None when MuJoCo is not installed. `scene`:
+    dict with centres [(x, y)], radius, mass, mu, walls (x_left, x_right) or None, v0 [(vx, vy, w)]."""
+    try:
+        import mujoco
+    except ImportError:
+        return None
+    r, m, mu = scene["radius"], scene["mass"], scene["mu"]
+    bodies = "".join(
+        f'<body pos="{x} 0 {y}"><joint type="slide" axis="1 0 0"/><joint type="slide" axis="0 0 1"/>'
+        f'<joint type="hinge" axis="0 1 0"/><geom type="sphere" size="{r}" mass="{m}"/></body>'
+        for x, y in scene["centres"])
+    walls = ""
+    if scene["walls"]:
+        left, right = scene["walls"]
+        walls = (f'<geom type="plane" size="50 50 0.1" pos="{left} 0 0" zaxis="1 0 0"/>'
+                 f'<geom type="plane" size="50 50 0.1" pos="{right} 0 0" zaxis="-1 0 0"/>')
+    xml = (f'<mujoco><option timestep="{h}"/><default><geom friction="{mu} 0.005 0.0001" condim="3"/></default>'
+           f'<worldbody><geom type="plane" size="50 50 0.1"/>{walls}{bodies}</worldbody></mujoco>')
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+
+    def reset():
+        mujoco.mj_resetData(model, data)
+        for b, (vx, vy, w) in enumerate(scene["v0"]):
+            data.qvel[3 * b: 3 * b + 3] = (vx, vy, -w)  # our ω about +z is −ω about MuJoCo's +y
+
+    return _median_step_us(lambda: mujoco.mj_step(model, data), reset, steps, repeats)
+
+
+def pybullet_step_us(scene, h, steps, repeats):
+    """stepSimulation per step (DIRECT mode), or None when PyBullet is not installed."""
+    try:
+        import pybullet as pb
+    except ImportError:
+        return None
+    client = pb.connect(pb.DIRECT)
+    try:
+        r, m, mu = scene["radius"], scene["mass"], scene["mu"]
+        pb.setGravity(0, 0, -9.81, physicsClientId=client)
+        pb.setTimeStep(h, physicsClientId=client)
+        fixed = [pb.createMultiBody(0, pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=client),
+                                    physicsClientId=client)]
+        if scene["walls"]:
+            box = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[0.5, 5, 5], physicsClientId=client)
+            left, right = scene["walls"]
+            fixed += [pb.createMultiBody(0, box, basePosition=[left - 0.5, 0, 0], physicsClientId=client),
+                      pb.createMultiBody(0, box, basePosition=[right + 0.5, 0, 0], physicsClientId=client)]
+        sphere = pb.createCollisionShape(pb.GEOM_SPHERE, radius=r, physicsClientId=client)
+        balls = [pb.createMultiBody(m, sphere, basePosition=[x, 0, y], physicsClientId=client)
+                 for x, y in scene["centres"]]
+        for body in fixed + balls:
+            pb.changeDynamics(body, -1, lateralFriction=mu, restitution=0.0, physicsClientId=client)
+
+        def reset():
+            for ball, (x, y), (vx, vy, w) in zip(balls, scene["centres"], scene["v0"]):
+                pb.resetBasePositionAndOrientation(ball, [x, 0, y], [0, 0, 0, 1], physicsClientId=client)
+                pb.resetBaseVelocity(ball, [vx, 0, vy], [0, -w, 0], physicsClientId=client)
+
+        return _median_step_us(lambda: pb.stepSimulation(physicsClientId=client), reset, steps, repeats)
+    finally:
+        pb.disconnect(physicsClientId=client)
+
+
+def pymunk_step_us(scene, h, steps, repeats, iterations):
+    """space.step per step with `iterations`, or None when pymunk is not installed."""
+    try:
+        import pymunk
+    except ImportError:
+        return None
+    r, m, mu = scene["radius"], scene["mass"], scene["mu"]
+    friction = math.sqrt(mu)  # Chipmunk's pair friction is the product of the shapes'
+    holder = {}
+
+    def reset():
+        space = pymunk.Space()
+        space.iterations = iterations
+        space.gravity = (0.0, -9.81)
+        lines = [((-50.0, 0.0), (50.0, 0.0))]
+        if scene["walls"]:
+            left, right = scene["walls"]
+            lines += [((left, 0.0), (left, 50.0)), ((right, 0.0), (right, 50.0))]
+        for a, b in lines:
+            segment = pymunk.Segment(space.static_body, a, b, 0.0)
+            segment.friction, segment.elasticity = friction, 0.0
+            space.add(segment)
+        for (x, y), (vx, vy, w) in zip(scene["centres"], scene["v0"]):
+            body = pymunk.Body(m, 0.4 * m * r * r)
+            body.position, body.velocity, body.angular_velocity = (x, y), (vx, vy), w
+            circle = pymunk.Circle(body, r)
+            circle.friction, circle.elasticity = friction, 0.0
+            space.add(body, circle)
+        holder["space"] = space
+
+    return _median_step_us(lambda: holder["space"].step(h), reset, steps, repeats)
+
+
+def peers_step_us(scene, h, steps, repeats):
+    """[(peer, µs per step)] of every installed peer on `scene` (see mujoco_planar_step_us)."""
+    out = []
+    for name, cost in (("mujoco", lambda: mujoco_planar_step_us(scene, h, steps, repeats)),
+                       ("bullet", lambda: pybullet_step_us(scene, h, steps, repeats)),
+                       ("pymunk10", lambda: pymunk_step_us(scene, h, steps, repeats, 10)),
+                       ("pymunk100", lambda: pymunk_step_us(scene, h, steps, repeats, 100))):
+        us = cost()
+        if us is not None:
+            out.append((name, us))
+    return out
