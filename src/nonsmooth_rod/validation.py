@@ -177,6 +177,8 @@ def require_state(name: str, value, n_dof: int):
         raise InputError(f"{name} must be a sequence of {n_dof} numbers, got {quoted(value)}") from None
     if array.shape != (n_dof,):
         raise InputError(f"{name} must hold {n_dof} numbers (x, y, θ per body), got shape {array.shape}")
+    if np.max(np.abs(array), initial=0.0) <= MAX_STATE:  # one reduction for the common case (NaN fails it)
+        return array
     if not np.all(np.isfinite(array)):
         raise InputError(f"{name} must be finite, got {quoted(array.tolist())}")
     if np.max(np.abs(array), initial=0.0) > MAX_STATE:

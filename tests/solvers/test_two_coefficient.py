@@ -11,7 +11,7 @@ from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import Line, PointOnLine
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
-from nonsmooth_rod.solvers.kernels import KERNEL_SOLVED, SOLVER_CODES
+from nonsmooth_rod.solvers.kernels import KERNEL_SOLVED, SOLVER_CODES, solver_scratch
 from nonsmooth_rod.solvers.two_coefficient import (GROUP_MIN_CONTACTS, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,
                                                    two_coefficient_by_group, two_coefficient_kernel)
 from solver_cases import block_on_incline
@@ -44,7 +44,7 @@ def test_each_group_gets_the_answer_it_gets_alone(solver, compiled):
     n = len(mu_s)
     p, u, states, guess = np.zeros(2 * n), np.zeros(2 * n), np.zeros(n, dtype=np.int64), np.zeros(n)
     status, solves, _, consistent, _ = by_group(SOLVER_CODES[solver], W, q, mu_s, mu_d, guess, np.zeros(n),
-                                               np.ones(n), 0.0, 0, p, u, states)
+                                               np.ones(n), 0.0, 0, p, u, states, *solver_scratch(2))
     assert status == KERNEL_SOLVED and consistent
     empty = np.zeros(0, dtype=np.int64)
     total_solves = 0

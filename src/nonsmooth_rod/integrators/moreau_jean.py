@@ -480,8 +480,8 @@ def _boundary_offset(before, after, k, i, records, mu_s, h, slip_velocity):
 def _contact_phases(runs, grid, k_end, t_final, min_phase):
     """The phases of one contact's runs of one state (first step, code) up to step k_end."""
     runs = [(k, c) for k, c in runs if k < k_end]
-    if len(runs) == 1:  # one state all along (most of a pile's declared pairs): no arrays (issue 26)
-        return [Phase(STATE_NAMES[runs[0][1]], grid.origin + runs[0][0] * grid.h, t_final)]
+    if len(runs) == 1:  # one state all along (most contacts of a short run): one phase
+        return [Phase(STATE_NAMES[runs[0][1]], grid.origin + float(runs[0][0]) * grid.h, t_final)]
     starts = np.array([k for k, _ in runs], dtype=np.int64)
     bounds = np.r_[grid.origin + starts.astype(float) * grid.h, t_final]
     return phases_from_intervals(bounds, [STATE_NAMES[c] for _, c in runs], min_phase)

@@ -14,7 +14,9 @@ compiled call, whichever solver iparams names); `compiled_step` runs one step wi
 loop that calls back a Python `applied_force`). Arrays are grouped in three tuples so every
 kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
 (records). model and work are built by `_model_and_work` in moreau_jean.py, out by `Window` in
-moreau_jean_records.py (the run in windows of rows).
+moreau_jean_records.py (the run in windows of rows). A fourth tuple, the scratch (`step_scratch`,
+S_* slots), holds a step's temporaries — the step problem, the solver's tableaux, the sparse W —
+allocated once per call of the loop, so that a step allocates nothing.
 """
 from __future__ import annotations
 
@@ -38,9 +40,9 @@ from ..model.forces import accumulate_forces
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
                              KIND_DISK_ON_DISK,
                              contact_kinematics, local_dot)
-from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS
+from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
-                                       two_coefficient_by_group, two_coefficient_kernel)
+                                       two_coefficient_by_group, two_coefficient_into)
 
 # Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
 # of a few ulps either side of zero, and must not be left out of the step for that.
@@ -76,6 +78,14 @@ P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0, P_H_GRID = range(7)
 N_PARAMS = 7
 I_SOLVER, I_MAX_ITER, I_STOP, I_TIME_INVARIANT = range(4)
 N_IPARAMS = 4
+# Slots of the per-run scratch (step_scratch): the step's temporaries, allocated once per call of
+# run_steps (or compiled_step) instead of ~40 small arrays per step. Sized by the scene's contacts;
+# the dense W (lemke, enum) for steps of up to SCRATCH_W_CONTACTS active contacts, the solver's
+# (kernel_base.solver_scratch) for groups of up to SCRATCH_SOLVER_CONTACTS: larger ones allocate
+# their own, as every step did before.
+S_FLOATS, S_STATES, S_W, S_SOLVER_FLOATS, S_SOLVER_INTS, S_SPARSE_INTS, S_SPARSE_FLOATS = range(7)
+SCRATCH_W_CONTACTS = 64
+SCRATCH_SOLVER_CONTACTS = 16
 
 
 @jit
@@ -192,9 +202,11 @@ def _fill_block(blocks, k, hn, ht, index, i, j, minv):
 
 
 @jit
-def _contacts_by_body(na, active, index, n_bodies):
-    """(start, members): the active contacts (positions in `active`) touching each body, CSR."""
-    start = np.zeros(n_bodies + 1, dtype=np.int64)
+def _contacts_by_body(na, active, index, start, fill, members):
+    """start, members: the active contacts (positions in `active`) touching each body, CSR
+    (start: n_bodies + 1 entries, members: 2 na; fill: n_bodies + 1 entries of scratch)."""
+    n_bodies = start.shape[0] - 1
+    start[:] = 0
     for a in range(na):
         for side in range(2):
             body = index[active[a], CI_BODY_A + side]
@@ -202,31 +214,38 @@ def _contacts_by_body(na, active, index, n_bodies):
                 start[body + 1] += 1
     for b in range(n_bodies):
         start[b + 1] += start[b]
-    members = np.empty(start[n_bodies], dtype=np.int64)
-    fill = start.copy()
+    fill[:] = start
     for a in range(na):
         for side in range(2):
             body = index[active[a], CI_BODY_A + side]
             if body >= 0:
                 members[fill[body]] = a
                 fill[body] += 1
-    return start, members
 
 
 @jit
-def delassus_blocks(na, model, work):
+def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
     """The block-sparse Delassus matrix over the active contacts (solvers.kernels' CSR layout:
     indptr, indices, 2×2 blocks): a block for each pair of contacts sharing a body, so building
-    it costs O(active contacts × contacts per body), not O(contacts²)."""
-    minv, index = model[0], model[3]
-    hn, ht, active = work[2], work[3], work[4]
-    start, members = _contacts_by_body(na, active, index, minv.shape[0] // 3)
-    indptr = np.zeros(na + 1, dtype=np.int64)
-    seen = np.full(na, -1, dtype=np.int64)
+    it costs O(active contacts × contacts per body), not O(contacts²). Carved from the scratch
+    (ints, floats: S_SPARSE_INTS, S_SPARSE_FLOATS, sized by step_scratch for any active set). The
+    arrays it reads are passed one by one: a call that takes the model and work tuples costs
+    ~10 ns of reference counting per array in them, every step."""
+    n_bodies = minv.shape[0] // 3
+    start, at = carve(ints, 0, n_bodies + 1)
+    fill, at = carve(ints, at, n_bodies + 1)
+    members, at = carve(ints, at, 2 * na)
+    indptr, at = carve(ints, at, na + 1)
+    seen, at = carve(ints, at, na)
+    _contacts_by_body(na, active, index, start, fill, members)
+    indptr[0] = 0
+    seen[:] = -1
     for sweep in range(2):  # count, then fill
         if sweep == 1:
-            indices = np.empty(indptr[na], dtype=np.int64)
-            blocks = np.empty((indptr[na], 2, 2))
+            nnz = indptr[na]
+            fits = at + nnz <= ints.shape[0] and 4 * nnz <= floats.shape[0]
+            indices = ints[at:at + nnz] if fits else np.empty(nnz, dtype=np.int64)
+            blocks = floats[:4 * nnz].reshape((nnz, 2, 2)) if fits else np.empty((nnz, 2, 2))
             seen[:] = -1
         for a in range(na):
             n = 0
@@ -243,6 +262,23 @@ def delassus_blocks(na, model, work):
             if sweep == 0:
                 indptr[a + 1] = indptr[a] + n
     return indptr, indices, blocks
+
+
+@jit
+def _sparse_capacity(index, n_bodies):
+    """The most blocks the block-sparse W of any set of active contacts can hold: per contact,
+    the contacts touching its bodies."""
+    touching = np.zeros(n_bodies, dtype=np.int64)
+    for i in range(index.shape[0]):
+        for side in range(2):
+            if index[i, CI_BODY_A + side] >= 0:
+                touching[index[i, CI_BODY_A + side]] += 1
+    blocks = 0
+    for i in range(index.shape[0]):
+        for side in range(2):
+            if index[i, CI_BODY_A + side] >= 0:
+                blocks += touching[index[i, CI_BODY_A + side]]
+    return blocks
 
 
 @_inlined
@@ -401,9 +437,8 @@ def _rides_the_gap(i, params, work, index, v_next):
 
 
 @_inlined
-def _warm_start(k, na, work, out, p):
+def _warm_start(k, na, active, was_closed, p_normal, p_tangent, p):
     """The previous step's impulses of the contacts that stay closed (pgs starts from p)."""
-    active, was_closed, p_normal, p_tangent = work[4], work[5], out[2], out[3]
     if k == 0:
         return
     for a in range(na):
@@ -412,31 +447,64 @@ def _warm_start(k, na, work, out, p):
             p[2 * a], p[2 * a + 1] = p_normal[k - 1, i], p_tangent[k - 1, i]
 
 
+@jit
+def step_scratch(solver_code, model):
+    """The per-run scratch tuple (S_* slots) for the packed scene `model`."""
+    n_contacts, n_bodies = model[2].shape[0], model[0].shape[0] // 3
+    sparse = solver_code == SOLVER_PGS
+    dense = 0 if sparse else min(n_contacts, SCRATCH_W_CONTACTS)
+    blocks = _sparse_capacity(model[3], n_bodies) if sparse else 0
+    solver_floats, solver_ints = solver_scratch(min(n_contacts, SCRATCH_SOLVER_CONTACTS))
+    sparse_ints = 2 * n_bodies + 4 * n_contacts + 3 + blocks if sparse else 0
+    return (np.empty(11 * n_contacts), np.empty(n_contacts, dtype=np.int64), np.empty(4 * dense * dense),
+            solver_floats, solver_ints, np.empty(sparse_ints, dtype=np.int64), np.empty(4 * blocks))
+
+
 @_inlined
-def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
-    """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
+def _dense_matrix(scratch, m, sparse):
+    """The step's dense W (m × m, every entry written by assemble): a view of the scratch, empty
+    for pgs, or a matrix of its own beyond the scratch's size."""
+    if sparse:
+        return carve_matrix(scratch[S_W], 0, 0, 0)[0]
+    if m * m <= scratch[S_W].shape[0]:
+        return carve_matrix(scratch[S_W], 0, m, m)[0]
+    return np.empty((m, m))
+
+
+@_inlined
+def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, p_normal, p_tangent, counters, scratch):
+    """assemble + the two-coefficient kernel, in the per-run scratch; p_normal, p_tangent: the
+    records (the warm start), counters: out's. Returns (kernel status, p, u, states). (Inlined
+    functions take only the arrays they use: each array of a tuple passed in costs ~10 ns of
+    reference counting per step.)"""
     m = 2 * na
     sparse = solver_code == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
-    W = np.zeros((0, 0)) if sparse else np.zeros((m, m))
-    q_step = np.empty(m)
-    guess, mu_s, mu_d, closing, resting = np.empty(na), np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+    W = _dense_matrix(scratch, m, sparse)
+    floats = scratch[S_FLOATS]
+    q_step, at = carve(floats, 0, m)
+    guess, at = carve(floats, at, na)
+    mu_s, at = carve(floats, at, na)
+    mu_d, at = carve(floats, at, na)
+    closing, at = carve(floats, at, na)
+    resting, at = carve(floats, at, na)
+    p, at = carve(floats, at, m)
+    u, at = carve(floats, at, m)
+    states = scratch[S_STATES][:na]
     assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing, resting)
+    p[:] = 0.0
+    u[:] = 0.0
+    states[:] = 0
+    _warm_start(k, na, work[4], work[5], p_normal, p_tangent, p)
     if sparse:
-        indptr, indices, blocks = delassus_blocks(na, model, work)
-    else:
-        indptr, indices, blocks = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2))
-    p, u = np.zeros(m), np.zeros(m)
-    _warm_start(k, na, work, out, p)
-    states = np.zeros(na, dtype=np.int64)
-    if sparse:
-        status, solves, iterations, consistent, fallbacks = two_coefficient_kernel(
+        indptr, indices, blocks = delassus_blocks(na, model[0], model[3], work[2], work[3], work[4],
+                                                  scratch[S_SPARSE_INTS], scratch[S_SPARSE_FLOATS])
+        status, solves, iterations, consistent, fallbacks = two_coefficient_into(
             solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL],
-            iparams[I_MAX_ITER], p, u, states)
+            iparams[I_MAX_ITER], p, u, states, scratch[S_SOLVER_FLOATS], scratch[S_SOLVER_INTS])
     else:  # lemke, enum: one group of coupled contacts at a time (their cost grows with the group)
         status, solves, iterations, consistent, fallbacks = two_coefficient_by_group(
             solver_code, W, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL], iparams[I_MAX_ITER], p, u,
-            states)
-    counters = out[9]
+            states, scratch[S_SOLVER_FLOATS], scratch[S_SOLVER_INTS])
     counters[K_SOLVES] += solves
     counters[K_ITERATIONS] += iterations
     counters[K_FALLBACKS] += fallbacks
@@ -446,18 +514,20 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
 
 
 @_inlined
-def _step(solver_code, k, f, params, iparams, model, work, out):
-    """One whole step with generalised force f; returns a run status (the solver read from its
-    code at run time: run_steps and compiled_step serve every solver)."""
+def _step(solver_code, k, f, params, iparams, model, work, out, scratch):
+    """One whole step with generalised force f, its temporaries in `scratch` (step_scratch);
+    returns a run status (the solver read from its code at run time: run_steps and compiled_step
+    serve every solver)."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
     na = begin_step(params, qk, vk, f, model, work)
     if na < 0:
         counters[K_FAIL_CONTACT] = -1 - na
         return RUN_BAD_GEOMETRY
-    p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
+    p, u, states = scratch[S_FLOATS][:0], scratch[S_FLOATS][:0], scratch[S_STATES][:0]  # no contact: no arrays
     if na > 0:
-        status, p, u, states = solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out)
+        status, p, u, states = solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out[2], out[3],
+                                          counters, scratch)
         if status != KERNEL_SOLVED:
             counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
@@ -473,12 +543,16 @@ def step_time(params, k):
 @_inlined
 def step_force(k, params, model, out, f):
     """f = weight + the packed forces at t_k + θh and (q_k, v_k)."""
-    weight, ftable = model[1], model[4]
-    q, v = out[0], out[1]
+    _packed_force(k, params, model[1], model[4], model[5], model[6], model[7], out[0], out[1], f)
+
+
+@_inlined
+def _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f):
+    """step_force on the force arrays themselves (the whole-run loop unpacks them once)."""
     f[:] = weight
     t = params[P_T0] + ((params[P_K0] + k) + params[P_THETA]) * params[P_H]
     if ftable.shape[0] > 0:
-        accumulate_forces(t, q[k], v[k], ftable, model[5], model[6], model[7], f)
+        accumulate_forces(t, q[k], v[k], ftable, findex, ftimes, fvalues, f)
 
 
 @_inlined
@@ -496,6 +570,8 @@ def end_of_step(k, status, counters):
 def _run(solver_code, k_start, k_end, params, iparams, model, work, out):
     """Steps k_start … k_end − 1 with the packed forces: the whole run in one call."""
     f = np.empty(model[0].shape[0])
+    scratch = step_scratch(solver_code, model)
+    weight, ftable, findex, ftimes, fvalues, q, v = model[1], model[4], model[5], model[6], model[7], out[0], out[1]
     counters = out[9]
     # The contacts' memory after each of the last three steps and the solver's counters before
     # them (a ring by step): what _fixed_period compares.
@@ -505,8 +581,8 @@ def _run(solver_code, k_start, k_end, params, iparams, model, work, out):
     while k < k_end:
         for c in range(len(REPEATED_COUNTERS)):
             before[k % 3, c] = counters[REPEATED_COUNTERS[c]]
-        step_force(k, params, model, out, f)
-        if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out), counters) != RUN_OK:
+        _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f)
+        if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out, scratch), counters) != RUN_OK:
             return counters[K_STATUS]
         for i in range(memory.shape[2]):
             memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = work[5][i], work[6][i], work[7][i]
@@ -591,10 +667,12 @@ def run_steps(k_start, k_end, params, iparams, model, work, out):
 # The same for the step-wise loop (a Python applied_force called back between steps).
 @jit
 def compiled_step(k, f, params, iparams, model, work, out):
-    """One step (_step) with the solver iparams[I_SOLVER] names."""
-    return _step(iparams[I_SOLVER], k, f, params, iparams, model, work, out)
+    """One step (_step) with the solver iparams[I_SOLVER] names (its scratch allocated per call: this
+    entry serves the loop that calls a Python force back between steps)."""
+    return _step(iparams[I_SOLVER], k, f, params, iparams, model, work, out,
+                 step_scratch(iparams[I_SOLVER], model))
 
 
-__all__ = ["begin_step", "assemble", "solve_step", "finish_step", "step_force", "run_steps", "compiled_step",
+__all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "finish_step", "step_force", "run_steps", "compiled_step",
            "crossing_offset", "ACTIVATION_ROUNDOFF"]
 

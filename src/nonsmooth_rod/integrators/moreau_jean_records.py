@@ -177,10 +177,9 @@ def kept_steps(grid: Grid, lo: int, hi: int, save_every: float | None) -> np.nda
     (the first step of each slot of the common origin) and the run's last."""
     k = np.arange(lo, hi + 1)
     if save_every is None:
-        keep = np.ones(k.shape, dtype=bool)
-    else:
-        slot = np.floor(k * grid.h / save_every + 1e-9)
-        keep = slot != np.floor((k - 1) * grid.h / save_every + 1e-9)
+        return k
+    slot = np.floor(k * grid.h / save_every + 1e-9)
+    keep = slot != np.floor((k - 1) * grid.h / save_every + 1e-9)
     keep |= (k == grid.first) | (k == grid.last)
     return k[keep]
 
@@ -236,6 +235,8 @@ class Collector:
 
     def _samples(self, window: Window, ks: np.ndarray) -> None:
         out, rows = window.out, ks - window.k_base
+        if ks.size and ks[-1] - ks[0] + 1 == ks.size:
+            return self._contiguous_samples(window, int(rows[0]), ks)
         m = slice(self.n, self.n + ks.size)
         self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
         h = self.step_size(ks)[:, None]
@@ -247,14 +248,33 @@ class Collector:
         self.codes[m] = out[5][before]  # the first sample of a fresh run: the mode of its first step
         self.n += ks.size
 
+    def _contiguous_samples(self, window: Window, r0: int, ks: np.ndarray) -> None:
+        """_samples of consecutive steps after a window's first row (every step kept): slices,
+        not gathers — the same values."""
+        out, n = window.out, ks.size
+        if r0 == 0:  # the run's first state: no step leads to it
+            first = self.n
+            self.t[first], self.q[first], self.v[first] = self.grid.time(ks[:1])[0], out[0][0], out[1][0]
+            self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, out[5][0]
+            self.n, ks, r0, n = first + 1, ks[1:], 1, n - 1
+        rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(self.n, self.n + n)
+        h = self.grid.h if not (self.grid.h_last or self.resume is not None) else self.step_size(ks)[:, None]
+        self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
+        np.divide(out[1][rows] - out[1][before], h, out=self.a[m])
+        np.divide(out[2][before], h, out=self.N[m])
+        np.divide(out[3][before], h, out=self.T[m])
+        self.codes[m] = out[5][before]
+        self.n += n
+
     def _runs_and_rows(self, window: Window, k_from: int, k_to: int) -> None:
         out = window.out
         r_lo = 0 if self._codes_before is None else k_from - window.k_base  # a resumed run: from its history
         codes = out[5][r_lo: k_to - window.k_base]
         if not codes.shape[0]:
             return
-        before = codes[:1] - 1 if self._codes_before is None else self._codes_before[None, :]
-        changed = np.vstack([before, codes[:-1]]) != codes
+        changed = np.empty(codes.shape, dtype=bool)
+        np.not_equal(codes[1:], codes[:-1], out=changed[1:])
+        changed[0] = True if self._codes_before is None else codes[0] != self._codes_before
         rows_changed = np.flatnonzero(changed.any(axis=1))
         for m in rows_changed:  # few: a contact's state changes at its phase boundaries
             for i in np.flatnonzero(changed[m]):

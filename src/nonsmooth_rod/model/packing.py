@@ -68,8 +68,12 @@ def pack_contacts(contacts, n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
 def pack_disk_pairs(table, index):
     """The broad phase's tables: the distinct disks of the disk–disk contacts and, sorted by
     disk pair, which contact joins them."""
+    pairs = np.flatnonzero(index[:, CI_KIND] == KIND_DISK_ON_DISK)
+    if not pairs.size:  # most scenes: no table to build
+        no_ints = np.zeros(0, dtype=np.int64)
+        return np.zeros((0, 3)), no_ints, no_ints.copy(), no_ints.copy()
     disk_id, disks, bodies, keys, owners = {}, [], [], [], []
-    for i in np.flatnonzero(index[:, CI_KIND] == KIND_DISK_ON_DISK):
+    for i in pairs:
         ends = []
         for body, columns in ((index[i, CI_BODY_A], (C_OFF_AX, C_OFF_AY, C_RADIUS_A)),
                               (index[i, CI_BODY_B], (C_OFF_BX, C_OFF_BY, C_RADIUS_B))):

@@ -75,3 +75,44 @@ def problem_scale(q, p, u) -> float:
     return scale if scale > 0.0 else 1.0
 
 
+
+
+# ---------------------------------------------------------------- per-run scratch
+# A step's temporaries come from two buffers (floats, int64s) allocated once per run and carved
+# from the front, each level passing what it leaves to the level below (the sign iteration, then
+# Lemke): a numba allocation and its release cost ~60 ns each, and a step of the rod made ~40 of
+# them. A problem larger than the buffers gets buffers of its own (solver_scratch) instead.
+
+
+@jit
+def solver_floats(n_contacts):
+    """Floats the two-coefficient kernel and Lemke (the cone LCP, 4 unknowns per contact) take for
+    a problem of n_contacts contacts."""
+    n = n_contacts
+    return 52 * n * n + 64 * n + 16
+
+
+@jit
+def solver_scratch(n_contacts):
+    """(floats, int64s) for a problem of n_contacts contacts."""
+    return np.empty(solver_floats(n_contacts)), np.empty(8 * n_contacts + 8, dtype=np.int64)
+
+
+@jit
+def fitting_scratch(floats, ints, n_contacts):
+    """The scratch itself when it holds a problem of n_contacts contacts, else a new one."""
+    if floats.shape[0] >= solver_floats(n_contacts) and ints.shape[0] >= 8 * n_contacts + 8:
+        return floats, ints
+    return solver_scratch(n_contacts)
+
+
+@jit
+def carve(buffer, at, n):
+    """(buffer[at:at + n], at + n): the next n entries of a scratch buffer."""
+    return buffer[at:at + n], at + n
+
+
+@jit
+def carve_matrix(buffer, at, rows, cols):
+    """(the next rows × cols entries as a C-contiguous matrix, the offset after them)."""
+    return buffer[at:at + rows * cols].reshape((rows, cols)), at + rows * cols

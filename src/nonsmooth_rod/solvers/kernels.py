@@ -28,7 +28,7 @@ import numpy as np
 from .._jit import jit
 from .enumeration import enum_interval
 from .gauss_seidel import dense_to_blocks, pgs_block, pgs_dense
-from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_kernel
+from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into
 
 from .kernel_base import (
     DEFAULT_RTOL,
@@ -43,15 +43,20 @@ from .kernel_base import (
     SOLVER_PGS,
     STATUS_NAMES,
     all_finite,
+    carve,
+    carve_matrix,
     contact_residual,
+    fitting_scratch,
     problem_scale,
+    solver_scratch,
     step_residual,
 )
 
 
 @jit
-def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots):
-    """Lemke on the interval LCP, then on the cone LCP if that fails (as lemke_friction does).
+def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
+    """Lemke on the interval LCP, then on the cone LCP if that fails (as lemke_friction does),
+    in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0] contacts).
 
     Returns (status, pivots, residual); the first formulation's failure status when both fail.
     """
@@ -63,8 +68,8 @@ def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots):
     for attempt in range(2):
         formulation = INTERVAL if attempt == 0 else CONE
         limit = max_pivots if max_pivots > 0 else default_max_pivots((3 + attempt) * lo.shape[0])
-        p_new, u_new, residual, status, pivots, norms = _lemke_friction_kernel(
-            W, q, lo, hi, limit, formulation)
+        p_new, u_new, residual, status, pivots, norms = _lemke_friction_into(
+            W, q, lo, hi, limit, formulation, floats, ints)
         scale = norms[2] if norms[2] > 0.0 else 1.0
         if status == SOLVED and residual <= rtol * scale:
             p[:] = p_new
@@ -100,10 +105,18 @@ def _screened(status):
 @jit
 def solve_lemke(W, q, lo, hi, p, u, rtol, max_iter):
     """solve_interval with SOLVER_LEMKE."""
+    floats, ints = solver_scratch(lo.shape[0])
+    return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
+
+
+@jit
+def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+    """solve_lemke in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0]
+    contacts): what the Moreau–Jean loop calls, allocating nothing per step."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
-    return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter)
+    return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
 @jit
@@ -144,5 +157,5 @@ def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
 __all__ = [
     "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
     "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
-    "solve_interval", "solve_lemke", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
+    "solve_interval", "solve_lemke", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
 ]

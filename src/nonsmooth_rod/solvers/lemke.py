@@ -54,7 +54,7 @@ from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
-from .kernel_base import step_residual
+from .kernel_base import carve, carve_matrix, solver_scratch, step_residual
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -236,15 +236,15 @@ def _resume_pivoting(T, basis, n, entering, pivots, max_pivots):
 
 
 @jit
-def _basic_solution(T, basis, M, q, n, z):
-    """z from the final basis, with one step of iterative refinement against the original M, q.
+def _basic_solution(T, basis, M, q, n, z, residual):
+    """z from the final basis, with one step of iterative refinement against the original M, q
+    (`residual`: n floats of scratch).
 
     The basic values x satisfy B x = q with B's columns e_v (w_v), −M[:, c] (z_c) and −d (z0);
     the tableau's w columns hold B⁻¹, so x += B⁻¹ (q − B x) removes most of the round-off the
     pivots accumulated. Tiny negative values of round-off size are clipped to 0.
     """
     rhs = 2 * n + 1
-    residual = np.zeros(n)
     for k in range(n):
         residual[k] = q[k]
     for i in range(n):
@@ -272,17 +272,19 @@ def _basic_solution(T, basis, M, q, n, z):
 
 
 @jit
-def _lemke_kernel(M, q, max_pivots):
-    """Lemke on (M, q) given as rows/vector; returns (z, status, pivots, last entering)."""
+def _lemke_kernel(M, q, max_pivots, T, basis, z, residual):
+    """Lemke on (M, q) given as rows/vector, in the caller's scratch (T: n × (2n + 2), basis,
+    z, residual: n); fills z, returns (status, pivots, last entering)."""
     n = len(q)
-    T = np.zeros((n, 2 * n + 2))
+    T[:, :] = 0.0
     _fill_tableau(T, M, q, n)
-    basis = np.arange(n)
+    for i in range(n):
+        basis[i] = i
     status, pivots, entering = _complementary_pivoting(T, basis, n, max_pivots)
-    z = np.zeros(n)
+    z[:] = 0.0
     if status == SOLVED or status == RAY:  # at a ray z is the last point of the path
-        _basic_solution(T, basis, M, q, n, z)
-    return z, status, pivots, entering
+        _basic_solution(T, basis, M, q, n, z, residual)
+    return status, pivots, entering
 
 
 @jit
@@ -341,14 +343,13 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
 
 
 @jit
-def _contact_scales(W, n_c):
-    """Per contact the power of two nearest 1/√max(W_NN, W_TT) (1 for a zero block)."""
-    d = np.ones(n_c)
+def _contact_scales(W, n_c, d):
+    """d: per contact the power of two nearest 1/√max(W_NN, W_TT) (1 for a zero block)."""
     for c in range(n_c):
+        d[c] = 1.0
         diagonal = max(abs(W[2 * c][2 * c]), abs(W[2 * c + 1][2 * c + 1]))
         if diagonal > 0.0:
             d[c] = 2.0 ** (-np.round(0.5 * np.log2(diagonal)))
-    return d
 
 
 @jit
@@ -368,7 +369,16 @@ def _scaled_step(W, q, d, Ws, qs):
 
 @jit
 def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
-    """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms).
+    """_lemke_friction_into with scratch of its own: (p, u, residual, status, pivots, norms)."""
+    floats, ints = solver_scratch(len(lo))
+    return _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints)
+
+
+@jit
+def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints):
+    """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms), every
+    array carved from the scratch (floats, ints: kernel_base.solver_scratch of ≥ len(lo)
+    contacts; p and u are views of it).
 
     norms = (‖q‖∞, max|W|, max(‖p‖∞, ‖u‖∞, ‖q‖∞)) for the acceptance test and the contact
     states (computed here, they cost nothing; in Python after the call, microseconds).
@@ -381,21 +391,30 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     max|D q| / max|D W D| undoes it exactly.
     """
     n_c = len(lo)
-    d = _contact_scales(W, n_c)
-    Ws, qs = np.empty((2 * n_c, 2 * n_c)), np.empty(2 * n_c)
-    W_norm, q_norm, w_scale, q_scale = _scaled_step(W, q, d, Ws, qs)
     per_contact = 3 if formulation == INTERVAL else 4
     n = per_contact * n_c
-    M = np.zeros((n, n))
-    qq = np.zeros(n)
+    d, at = carve(floats, 0, n_c)
+    Ws, at = carve_matrix(floats, at, 2 * n_c, 2 * n_c)
+    qs, at = carve(floats, at, 2 * n_c)
+    M, at = carve_matrix(floats, at, n, n)
+    qq, at = carve(floats, at, n)
+    T, at = carve_matrix(floats, at, n, 2 * n + 2)
+    z, at = carve(floats, at, n)
+    refine, at = carve(floats, at, n)
+    p, at = carve(floats, at, 2 * n_c)
+    u, at = carve(floats, at, 2 * n_c)
+    _contact_scales(W, n_c, d)
+    W_norm, q_norm, w_scale, q_scale = _scaled_step(W, q, d, Ws, qs)
+    M[:, :] = 0.0
+    qq[:] = 0.0
     if formulation == INTERVAL:
         _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
         _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
-    z, status, pivots, entering = _lemke_kernel(M, qq, max_pivots)
+    status, pivots, entering = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)
 
-    p = np.zeros(2 * n_c)
-    u = np.zeros(2 * n_c)
+    p[:] = 0.0
+    u[:] = 0.0
     residual = 0.0
     if status == SOLVED or status == RAY:
         for j in range(n_c):
@@ -592,7 +611,7 @@ def _pivot_in_chunks(M, q, max_pivots, deadline, compiled):
         status, pivots, entering = resume(T, basis, n, entering, pivots, min(pivots + chunk, max_pivots))
     z = np.zeros(n)
     if status == SOLVED or status == RAY:  # at a ray z is the last point of the path
-        basic_solution(T, basis, M, q, n, z)
+        basic_solution(T, basis, M, q, n, z, np.zeros(n))
     return int(status), int(pivots), int(entering), z
 
 

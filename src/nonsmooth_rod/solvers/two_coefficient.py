@@ -29,7 +29,8 @@ from .._jit import jit
 # The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
 # Python (solve_two_coefficient below).
 from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS,
-                      lemke_interval, pgs_block, solve_enum, solve_interval, solve_lemke, solve_pgs)
+                      carve, carve_matrix, fitting_scratch, lemke_interval, pgs_block, solve_enum, solve_interval,
+                      solve_lemke_into, solve_pgs, solver_scratch)
 from ._common import interpreted
 from .problem import PlanarFrictionProblem, SolverError
 from .sticking import coupled_components, gather_contacts, group_matrix, prefer_sticking_by_group, scatter_contacts
@@ -149,7 +150,8 @@ def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallb
     if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
         return status, sweeps, residual, 0
     W = group_matrix(np.arange(na), np.zeros((0, 0)), indptr, indices, blocks)  # the whole W, dense
-    status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0)  # Lemke's own acceptance
+    floats, ints = solver_scratch(na)
+    status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0, floats, ints)  # Lemke's own acceptance
     return status, sweeps + pivots, residual, 1
 
 
@@ -159,15 +161,19 @@ def _defaults(rtol, max_iter):
     return rtol <= 0.0 and max_iter <= 0
 
 
-def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval on the dense W, or pgs_or_lemke when the block-sparse W is given (indptr).
-    Returns (status, iterations, residual, 1 if pgs fell back to Lemke else 0).
+def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+    """solve_interval on the dense W (Lemke in the scratch floats, ints), or pgs_or_lemke when
+    the block-sparse W is given (indptr). Returns (status, iterations, residual, 1 if pgs fell
+    back to Lemke else 0).
 
     Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
     that solver (`_solve_compiled`); lemke and enum then take the dense W."""
     if indptr.shape[0] > 0:
         return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter))
-    status, iterations, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+    if solver_code == SOLVER_LEMKE:
+        status, iterations, residual = solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
+    else:
+        status, iterations, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
     return status, iterations, residual, 0
 
 
@@ -177,17 +183,23 @@ if _jit.ENABLED:
     from numba.extending import overload
 
     @overload(_solve, prefer_literal=True)
-    def _solve_compiled(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+    def _solve_compiled(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
         """_solve for numba: one solver for a literal solver code (a cold compile then skips the
         others: issue 16), the run-time dispatch otherwise."""
-        dense = {SOLVER_LEMKE: solve_lemke, SOLVER_ENUM: solve_enum}.get(getattr(solver_code, "literal_value", None))
-        if dense is not None:
-            def solve_dense(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
-                status, iterations, residual = dense(W, q, lo, hi, p, u, rtol, max_iter)
+        literal = getattr(solver_code, "literal_value", None)
+        if literal == SOLVER_LEMKE:
+            def solve_lemke_only(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+                status, iterations, residual = solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
                 return status, iterations, residual, 0
-            return solve_dense
+            return solve_lemke_only
+        if literal == SOLVER_ENUM:
+            def solve_enum_only(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+                status, iterations, residual = solve_enum(W, q, lo, hi, p, u, rtol, max_iter)
+                return status, iterations, residual, 0
+            return solve_enum_only
         if getattr(solver_code, "literal_value", None) == SOLVER_PGS:
-            def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter):
+            def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats,
+                                 ints):
                 if indptr.shape[0] > 0:
                     return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter,
                                         _defaults(rtol, max_iter))
@@ -214,14 +226,15 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
     nothing to hold there. Groups of more than MAX_DENSE_HOLD contacts keep the solver's split.
     p_start: the previous step's impulses (the warm start), or empty."""
     na = mu_s.shape[0]
-    at_rest = np.empty(na)
     moving = False
     for i in range(na):
-        at_rest[i] = start_guess[i] if resting[i] > 0.0 else 2.0  # 2: not a candidate
-        if at_rest[i] == 0.0 and states[i] != STATE_STICK:
+        if resting[i] > 0.0 and start_guess[i] == 0.0 and states[i] != STATE_STICK:
             moving = True
-    if not moving:
+    if not moving:  # the common step: nothing to search, nothing allocated
         return False
+    at_rest = np.empty(na)
+    for i in range(na):
+        at_rest[i] = start_guess[i] if resting[i] > 0.0 else 2.0  # 2: not a candidate
     return prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, at_rest, velocity_tol, closing, p,
                                     u, states, MAX_DENSE_HOLD, p_start)
 
@@ -229,18 +242,35 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
 @jit
 def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting, rtol,
                            max_iter, p, u, states):
+    """two_coefficient_into with scratch of its own."""
+    floats, ints = solver_scratch(guess.shape[0])
+    return two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting,
+                                rtol, max_iter, p, u, states, floats, ints)
+
+
+@jit
+def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting, rtol,
+                         max_iter, p, u, states, floats, ints):
     """The exact two-coefficient law on u = W p + q, from slip guess `guess` (updated in place to
     the converged guess). W is dense (m × m), or empty with its block-sparse form (indptr,
     indices, blocks: solvers.kernels' layout) for pgs. p holds the warm start (pgs). `closing`
     (per contact): the gap-closing part g/h of q_N, which a held body may leave open; `resting`:
     1 for a contact whose slip velocity at the step's start is round-off. Once the
     sign iteration is consistent, a contact that started at rest slides only if no admissible
-    impulse split holds it (hold_at_rest).
+    impulse split holds it (hold_at_rest). floats, ints: scratch (kernel_base.solver_scratch;
+    one of its own when they are too small for these contacts).
     Returns (kernel status, solves, solver iterations, consistent, pgs steps solved again by Lemke)."""
     na = guess.shape[0]
-    start_guess, p_start = guess.copy(), p.copy()  # p_start: the warm start, the previous step's split
-    lo, hi, new_guess = np.empty(na), np.empty(na), np.empty(na)
-    tried = np.empty((MAX_SOLVES + 1, na))
+    floats, ints = fitting_scratch(floats, ints, na)
+    start_guess, at = carve(floats, 0, na)
+    p_start, at = carve(floats, at, 2 * na)  # the warm start, the previous step's split
+    start_guess[:] = guess
+    p_start[:] = p
+    lo, at = carve(floats, at, na)
+    hi, at = carve(floats, at, na)
+    new_guess, at = carve(floats, at, na)
+    tried, at = carve_matrix(floats, at, MAX_SOLVES + 1, na)
+    below = floats[at:]  # the solver's part of the scratch
     scale_v = 1e-12
     for r in range(2 * na):
         scale_v = max(scale_v, abs(q[r]))
@@ -251,7 +281,7 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
         n_tried += 1
         _interval_of(mu_s, mu_d, guess, lo, hi)
         status, its, residual, fell_back = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol,
-                                                  max_iter)
+                                                  max_iter, below, ints)
         iterations += its
         fallbacks += fell_back
         if status != KERNEL_SOLVED:
@@ -279,32 +309,37 @@ GROUP_MIN_CONTACTS = 4
 
 
 @jit
-def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states):
-    """two_coefficient_kernel on a dense W one group of coupled contacts at a time: W is
+def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states,
+                             floats, ints):
+    """two_coefficient_into on a dense W one group of coupled contacts at a time: W is
     block-diagonal over the groups (contacts linked through shared bodies), so the step's
     problem is their independent problems — and Lemke's tableau (cubic) and enum's 4ⁿ modes grow
     with a group, not with the step. The sign iteration also runs per group: a cycle in one
     group no longer resets the guesses of another. Steps of at most GROUP_MIN_CONTACTS contacts
-    are solved whole. The same returns as two_coefficient_kernel (solves, iterations and
-    fallbacks summed; consistent when every group is)."""
+    are solved whole. floats, ints: the scratch (kernel_base.solver_scratch). The same returns
+    as two_coefficient_kernel (solves, iterations and fallbacks summed; consistent when every
+    group is)."""
     na = mu_s.shape[0]
-    empty, no_blocks = np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2))
+    empty, no_blocks = ints[:0], floats[:0].reshape((0, 2, 2))  # no sparse W (views: nothing allocated)
+    if na <= GROUP_MIN_CONTACTS:
+        return two_coefficient_into(solver_code, W, empty, empty, no_blocks, q, mu_s, mu_d, guess, closing, resting,
+                                    rtol, max_iter, p, u, states, floats, ints)
     label = np.empty(na, dtype=np.int64)
-    groups = 1 if na <= GROUP_MIN_CONTACTS else coupled_components(empty, empty, W, label)
+    groups = coupled_components(empty, empty, W, label)
     if groups == 1:
-        return two_coefficient_kernel(solver_code, W, empty, empty, no_blocks, q, mu_s, mu_d, guess, closing, resting,
-                                      rtol, max_iter, p, u, states)
+        return two_coefficient_into(solver_code, W, empty, empty, no_blocks, q, mu_s, mu_d, guess, closing, resting,
+                                    rtol, max_iter, p, u, states, floats, ints)
     solves, iterations, fallbacks, consistent = 0, 0, 0, True
     for g in range(groups):
         members = np.flatnonzero(label == g)
         pg, ug, states_g = gather_contacts(members, p, True), gather_contacts(members, u, True), \
             gather_contacts(members, states, False)
         guess_g = gather_contacts(members, guess, False)
-        status, n_solves, its, group_consistent, fell_back = two_coefficient_kernel(
+        status, n_solves, its, group_consistent, fell_back = two_coefficient_into(
             solver_code, group_matrix(members, W, empty, empty, no_blocks), empty, empty, no_blocks,
             gather_contacts(members, q, True), gather_contacts(members, mu_s, False),
             gather_contacts(members, mu_d, False), guess_g, gather_contacts(members, closing, False),
-            gather_contacts(members, resting, False), rtol, max_iter, pg, ug, states_g)
+            gather_contacts(members, resting, False), rtol, max_iter, pg, ug, states_g, floats, ints)
         solves, iterations, fallbacks = solves + n_solves, iterations + its, fallbacks + fell_back
         consistent = consistent and group_consistent
         scatter_contacts(members, pg, ug, states_g, p, u, states)
@@ -362,6 +397,6 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                              float(sol.residual), consistent)
 
 
-__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_by_group", "StepContactResult",
+__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_into", "two_coefficient_by_group", "StepContactResult",
            "classify_solution",
            "next_action", "solve_interval", "SolverError", "STATE_NAMES"]
