@@ -119,7 +119,7 @@ def test_grazing_break_away_follows_the_exact_law(delta):
     assert [p.mode for p in fixed.phases] != modes  # the test can fail: fixed steps get it wrong
     run = simulate_rod(problem, "moreau-jean", tol=1e-4)
     assert [p.mode for p in run.phases] == modes
-    assert [round(p.t_end, 3) for p in run.phases] == [round(p.t_end, 3) for p in reference.phases]
+    assert np.allclose([p.t_end for p in run.phases], [p.t_end for p in reference.phases], rtol=0, atol=2e-4)
 
 
 def test_tol_keeps_the_result_shape_and_h_caps_the_step():
@@ -128,7 +128,8 @@ def test_tol_keeps_the_result_shape_and_h_caps_the_step():
     run = nr.simulate(ball.scene(), q0, v0, 0.5, "moreau-jean", tol=1e-4, h=5e-3)
     steps = np.diff(run.trajectory.t)
     assert run.trajectory.t[-1] == 0.5 and np.all(steps > 0) and steps.max() <= 5e-3 * (1 + 1e-12)
-    assert steps.min() < 0.1 * steps.max()  # smaller near the impact
+    impact_window = steps[np.searchsorted(run.trajectory.t, run.impacts[0].t) - 1]
+    assert impact_window <= 8e-4 < steps.max()  # 8 fine steps of tol/2 at the impact, long ones elsewhere
     assert run.trajectory.q.shape == (len(run.trajectory.t), 3)
     assert abs(run.impacts[0].t - ball.first_impact_time) <= 1e-4
     assert [p.mode for p in run.phases["floor"]] == ["open", "stick"]
@@ -142,3 +143,17 @@ def test_bad_tol_is_refused(tol):
     q0, v0 = ball.initial_state()
     with pytest.raises(InputError, match="tol"):
         nr.simulate(ball.scene(), q0, v0, 0.1, "moreau-jean", tol=tol)
+
+
+def test_restart_and_saved_results_go_on_with_tol(tmp_path):
+    """A run with tol restarts from its end state with tol (off the fixed grid) and saves and
+    loads like any result; the second half lands the ball at the closed form's impact."""
+    ball = BouncingBall(drop_height=0.2, restitution=0.0)
+    q0, v0 = ball.initial_state()
+    first = nr.simulate(ball.scene(), q0, v0, 0.1, "moreau-jean", tol=1e-5)
+    again = first.restart(t_end=0.4)
+    assert again.status == "ok" and again.trajectory.t[0] == 0.1 and again.trajectory.t[-1] == 0.4
+    assert abs(again.impacts[0].t - ball.first_impact_time) <= 1e-5
+    first.save(tmp_path / "run")
+    loaded = nr.load(tmp_path / "run")
+    assert np.array_equal(loaded.trajectory.t, first.trajectory.t)

@@ -374,7 +374,7 @@ def _impacts(scene, points: list, names: list, position_error: np.ndarray):
             speed = max(abs(float(kin.H_N @ v_hit)), 1e-300)
             error = point.h + points[k - 1].h + position_error[k] / speed
             impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v_after, p_n, p_t))
-            events.append(Event(t_hit, "impact", names[i], {"error": error}))
+            events.append(Event(t_hit, "impact", names[i], {"error": float(error)}))
     return impacts, events
 
 
@@ -404,7 +404,7 @@ def _phases(points: list, names: list, impacts: list, min_phase: float, t_stop: 
             if before.mode != "open":
                 events.append(Event(after.t_start, boundary_kind.get(after.mode, "stick-slip"), name,
                                     {"from": before.mode, "to": after.mode, "located": "refined",
-                                     "error": errors.get(after.t_start, 0.0)}))
+                                     "error": float(errors.get(after.t_start, 0.0))}))
         phases[name] = found
     return phases, events
 
@@ -439,7 +439,8 @@ def _result(integrator, scene, ctrl: Controller, stepper: Stepper, ending, names
              "min_step": float(steps.min()) if steps.size else math.nan,
              "max_step": float(steps.max()) if steps.size else math.nan,
              "error_estimate": float(position_error[-1]),
-             "event_time_error_estimate": max((e.detail["error"] for e in events if "error" in e.detail), default=0.0)}
+             "event_time_error_estimate": float(max((e.detail["error"] for e in events if "error" in e.detail),
+                                                    default=0.0))}
     result = SimulationResult(integrator.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, events,
                               impacts, phases, steps=len(points) - 1, cpu_time_s=cpu, stats=stats)
     result.end_state = _end_state(points, ctrl) if status != "failed" else None
