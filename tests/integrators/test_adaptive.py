@@ -32,17 +32,17 @@ def _measured(reference, tol=None, h=None):
 
 def test_rod_meets_the_tolerance_for_less_work_than_fixed_steps(rod_reference):
     """Case 2 at tol = 1e-5: impact time, x_O and every phase boundary within tol (the event-driven
-    reference at rtol 1e-12); fixed steps of 1e-4 s, first order, are 20 times less accurate for
-    about half the step evaluations (matching the error would take ~20 times their steps)."""
+    reference at rtol 1e-12); fixed steps of 1e-5 s are less accurate on the impact for more steps
+    than all the steps error control runs (both of each window's runs counted)."""
     tol = 1e-5
     run, m = _measured(rod_reference, tol=tol)
     assert run.status == "ok"
     assert m["phase_sequence_ok"]
     assert m["impact_error_s"] <= tol and m["x_O_error_m"] <= tol
-    assert m["phase_boundary_error_s"] <= 2 * tol
-    fixed, mf = _measured(rod_reference, h=1e-4)
-    assert mf["impact_error_s"] > 10 * m["impact_error_s"]
-    assert run.result.stats["step_evaluations"] < 3 * fixed.result.steps
+    assert m["phase_boundary_error_s"] <= tol
+    fixed, mf = _measured(rod_reference, h=1e-5)
+    assert mf["impact_error_s"] > m["impact_error_s"]
+    assert run.result.stats["step_evaluations"] < fixed.result.steps
 
 
 def test_rod_error_estimates_bound_the_errors(rod_reference):
@@ -111,7 +111,7 @@ def _grazing_problem(delta: float) -> RodProblem:
 def test_grazing_break_away_follows_the_exact_law(delta):
     """μs just above the rolling rod's largest T/N: the rod must not break away at the peak. Fixed
     steps of 1e-3 s do (their T/N overshoots by ~0.22 h/s); with tol = 1e-4 the phases are the
-    event-driven reference's (a break-away is accepted only from steps of tol/16)."""
+    event-driven reference's (a break-away is accepted only from steps of tol/2)."""
     problem = _grazing_problem(delta)
     reference = simulate_rod(problem, "event-driven")
     modes = [p.mode for p in reference.phases]
@@ -129,7 +129,7 @@ def test_tol_keeps_the_result_shape_and_h_caps_the_step():
     steps = np.diff(run.trajectory.t)
     assert run.trajectory.t[-1] == 0.5 and np.all(steps > 0) and steps.max() <= 5e-3 * (1 + 1e-12)
     impact_window = steps[np.searchsorted(run.trajectory.t, run.impacts[0].t) - 1]
-    assert impact_window <= 8e-4 < steps.max()  # 8 fine steps of tol/2 at the impact, long ones elsewhere
+    assert impact_window <= 32 * 1e-4 < steps.max()  # fine steps of tol/2 at the impact, long windows elsewhere
     assert run.trajectory.q.shape == (len(run.trajectory.t), 3)
     assert abs(run.impacts[0].t - ball.first_impact_time) <= 1e-4
     assert [p.mode for p in run.phases["floor"]] == ["open", "stick"]
