@@ -95,7 +95,8 @@ def _impact_of_b(problem: RodProblem, result: SimulationResult) -> dict | None:
 
 
 def simulate(problem: RodProblem | None = None, method: str = "event-driven", *, t_end: float | None = None,
-             h: float | None = None, solver: str = "lemke", tol: float | None = None, theta: float = 0.5, min_phase: float | None = None,
+             h: float | None = None, solver: str = "lemke", tol: float | None = None, theta: float = 0.5,
+             min_phase: float | None = None,
              rtol: float | None = None, output_dt: float = 1e-3, epsilon: float = 1e-4,
              friction_curve: str = "stribeck", ode_method: str | None = None, atol: float | None = None,
              stiffness: float | None = None, damping: float | None = None,
