@@ -96,3 +96,15 @@ def test_console_script_runs_moreau_jean(tmp_path):
     traj = read_csv(tmp_path / "trajectory.csv")
     # N and T are the step's impulses divided by h: N stays near the weight scale, positive.
     assert np.all(traj["N"][1:] > 0)
+
+
+def test_tol_chooses_moreau_jeans_steps(tmp_path, capsys):
+    """--tol: error control (docs/error_control.md); the impact of case 2 within it of the
+    event-driven reference's 0.375302 s."""
+    code = main(["simulate", "--method", "moreau-jean", "--tol", "1e-4", "--json", "--no-plot", "--out", str(tmp_path)])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert [p["mode"] for p in summary["phases"]] == ["stick", "slip-", "slip+"]
+    assert summary["impact"]["t"] == pytest.approx(0.3753022758552653, abs=1e-4)
+    assert summary["settings"]["tol"] == 1e-4 and summary["settings"]["h"] == 1e-2
+    assert main(["simulate", "--method", "moreau-jean", "--tol", "0", "--no-plot", "--out", str(tmp_path / "b")]) == 2

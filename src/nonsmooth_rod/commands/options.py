@@ -15,7 +15,7 @@ EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 RANGES = {
     "ball_radius": (1e-6, 10.0), "rod_diameter": (1e-6, 10.0), "length": (1e-5, 100.0),
     "density": (1e-3, 1e6), "mass": (1e-9, 1e9), "xi": (1e-6, 100.0), "inertia": (1e-15, 1e12),
-    "g": (0.0, 1e4), "t_end": (1e-9, 1e4), "h": (1e-9, 1.0), "rtol": (2.3e-14, 0.1), "atol": (1e-300, 1e-2),
+    "g": (0.0, 1e4), "t_end": (1e-9, 1e4), "h": (1e-9, 1.0), "tol": (1e-12, 0.1), "rtol": (2.3e-14, 0.1), "atol": (1e-300, 1e-2),
     "epsilon": (1e-12, 10.0), "stiffness": (1.0, 1e15), "damping": (0.0, 1e9), "min_phase": (0.0, 1e4),
     "time_limit": (1e-3, 1e6), "theta": (0.5, 1.0), "restitution": (0.0, 1.0), "max_step": (1e-9, 1e4),
 }

@@ -27,7 +27,12 @@ def register(subparsers) -> None:
     num = sim.add_argument_group("numerics")
     num.add_argument("--method", default="event-driven",
                      help="event-driven (default), moreau-jean, or the baselines regularized and switched")
-    num.add_argument("--h", type=number, default=1e-4, help="Moreau–Jean step size, s (default 1e-4)")
+    num.add_argument("--h", type=number, default=None,
+                     help="Moreau–Jean step size, s (default 1e-4); with --tol the first and largest step "
+                          "(default 1e-2)")
+    num.add_argument("--tol", type=number, default=None,
+                     help="Moreau–Jean error control: step sizes chosen for this tolerance on positions (m, rad) "
+                          "and on located event times (s); docs/error_control.md")
     num.add_argument("--solver", default="lemke", help="Moreau–Jean one-step solver (default lemke)")
     num.add_argument("--theta", type=number, default=0.5, help="Moreau–Jean θ in [0.5, 1] (default 0.5)")
     num.add_argument("--min-phase", type=number, default=None,
@@ -56,7 +61,7 @@ def register(subparsers) -> None:
 
 
 def _check_numerics(args) -> None:
-    for name in ("h", "rtol", "atol", "epsilon", "stiffness", "damping", "min_phase", "time_limit", "t_end",
+    for name in ("h", "tol", "rtol", "atol", "epsilon", "stiffness", "damping", "min_phase", "time_limit", "t_end",
                  "max_step"):
         require_range(name, getattr(args, name))
     if args.ode_method is not None and args.ode_method not in ODE_METHODS + ("rk4",):
@@ -104,8 +109,8 @@ def cmd_simulate(args) -> int:
     claim_folder(args.out, "simulate", args.force)
     out_dir = writable_folder(args.out)  # before the run: an unwritable --out is said at once
     extra = {} if args.max_step is None else {"max_step": args.max_step}
-    run = simulate(problem, args.method, t_end=args.t_end, h=args.h, solver=args.solver, theta=args.theta,
-                   min_phase=args.min_phase, rtol=args.rtol, atol=args.atol, epsilon=args.epsilon,
+    run = simulate(problem, args.method, t_end=args.t_end, h=args.h, tol=args.tol, solver=args.solver,
+                   theta=args.theta, min_phase=args.min_phase, rtol=args.rtol, atol=args.atol, epsilon=args.epsilon,
                    friction_curve=args.friction_curve, ode_method=args.ode_method, stiffness=args.stiffness,
                    damping=args.damping, time_limit=args.time_limit, **extra)
     remove_stale_temps(out_dir)

@@ -45,13 +45,17 @@ STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
 # Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
 # 0 means the kernel's own default (solvers/kernels.py).
 DEFAULT_RTOL, DEFAULT_MAX_ITER = 0.0, 0
+# The default step without tol; with tol, the default first and largest step (error control
+# shortens it where the tolerance asks).
+FIXED_STEP, MAX_STEP_WITH_TOL = 1e-4, 1e-2
 
 
 @dataclass
 class MoreauJeanOptions:
     """Step size, θ of the θ-method, contact activation and the one-step solver."""
 
-    h: float = option(1e-4, Number(0.0, open_lo=True), label="h (step size)")
+    # the step size; with tol, the first and largest step (default FIXED_STEP, with tol MAX_STEP_WITH_TOL)
+    h: float | None = option(None, Number(0.0, open_lo=True, optional=True), label="h (step size)")
     theta: float = option(0.5, Number(0.0, 1.0))
     # a contact enters the step when g + γ h u_N ≤ 0
     activation_gamma: float = option(0.5, Number(0.0, 1.0), label="activation_gamma")
@@ -64,6 +68,9 @@ class MoreauJeanOptions:
     # repeat an exact rest (a fixed point of the step) instead of solving it again: the same run
     # bit for bit, in a fraction of the time (docs/performance.md); off to time the steps themselves
     repeat_rest: bool = option(True, Flag())
+    # error control (integrators/adaptive.py): step sizes chosen for this tolerance on positions (m, rad)
+    # and on located event times (s); None: fixed steps of h
+    tol: float | None = option(None, Number(0.0, 0.1, open_lo=True, optional=True), label="tol")
 
     def __post_init__(self):
         check_options(self)
@@ -73,8 +80,10 @@ class MoreauJeanOptions:
                 f"theta = {self.theta:g} < 0.5 makes Moreau–Jean gain energy; use theta in [0.5, 1] "
                 "(or allow_energy_gain=True to study it)"
             )
+        if self.h is None:
+            self.h = FIXED_STEP if self.tol is None else MAX_STEP_WITH_TOL
         if self.min_phase is None:
-            self.min_phase = 2 * self.h
+            self.min_phase = 2 * (self.h if self.tol is None else self.tol)
 
 
 _ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
@@ -185,6 +194,9 @@ class MoreauJean:
         """How many samples a run keeps (the driver's memory check), counting the window of
         per-step rows it runs in and the temporaries of taking samples from it (measured:
         WINDOW_SAMPLES samples' worth a row, benchmarks/bench_memory.py)."""
+        if options.tol is not None:  # error control keeps its accepted steps until the run ends
+            from .adaptive import samples_estimate
+            return samples_estimate(options, duration)
         steps = duration / options.h
         kept = steps if save_every is None else min(steps, duration / save_every)
         return kept + 2 + WINDOW_SAMPLES * min(steps, MAX_CHUNK)
@@ -202,6 +214,8 @@ class MoreauJean:
             _check_resume(resume, scene.n_dof, len(names))
             if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
                 raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
+        if opts.tol is not None:
+            return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop, names)
         grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
         model, work = _model_and_work(packed, resume)
@@ -221,6 +235,21 @@ class MoreauJean:
                  "compiled": engine.compiled and solver_code is not None,
                  "force_callback": scene.applied_force is not None}
         return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
+
+    def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
+        """The error-controlled run (integrators/adaptive.py) on this integrator's loop and kernels."""
+        from .adaptive import run_adaptive
+
+        packed = pack_scene(scene)
+        model, work = _model_and_work(packed, resume)
+        params, iparams = self._parameters(scene, Grid.of(self.options.h, t0, t_end, None), names)
+        engine = Engine(bool(self.options.fast and _jit.ENABLED),
+                        *compiled_part(self.options.solver, COMPILED_SOLVERS.get(self.options.solver),
+                                       scene.applied_force is not None))
+        self._solver_error = None
+        with _jit.one_blas_thread():
+            return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
+                                model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
 
     def _parameters(self, scene, grid, names):
         opts = self.options

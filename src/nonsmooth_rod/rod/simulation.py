@@ -95,7 +95,8 @@ def _impact_of_b(problem: RodProblem, result: SimulationResult) -> dict | None:
 
 
 def simulate(problem: RodProblem | None = None, method: str = "event-driven", *, t_end: float | None = None,
-             h: float = 1e-4, solver: str = "lemke", theta: float = 0.5, min_phase: float | None = None,
+             h: float | None = None, solver: str = "lemke", tol: float | None = None, theta: float = 0.5,
+             min_phase: float | None = None,
              rtol: float | None = None, output_dt: float = 1e-3, epsilon: float = 1e-4,
              friction_curve: str = "stribeck", ode_method: str | None = None, atol: float | None = None,
              stiffness: float | None = None, damping: float | None = None,
@@ -107,7 +108,9 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
     1e-12, regularized and switched 1e-6). The baselines: "regularized" (friction curve
     `friction_curve` of width `epsilon`, penalty contact of `stiffness`/`damping`, scipy
     `ode_method`, atol default rtol·1e-3) and "switched" (the paper's sgn(v_C) equations,
-    `ode_method` "rk4" with step h or an adaptive scipy method); `time_limit` (wall seconds)
+    `ode_method` "rk4" with step h or an adaptive scipy method); h defaults to 1e-4 s, and with
+    `tol` (Moreau–Jean's error control, integrators/adaptive.py) it is the first and largest step
+    (default 1e-2 s); `time_limit` (wall seconds)
     stops either with status "time-limit"; `max_step` caps the event-driven step.
     """
     problem = problem or RodProblem.paper()
@@ -137,9 +140,16 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
 def _method_options(method: str, a: dict) -> tuple[dict, dict]:
     """The method's options from simulate()'s arguments, and the settings the summary records."""
     if method == "moreau-jean":
+        from ..integrators.moreau_jean import MoreauJeanOptions
+
         options = {"h": a["h"], "theta": a["theta"], "solver": a["solver"], "min_phase": a["min_phase"]}
-        settings = dict(options, min_phase=2 * a["h"] if a["min_phase"] is None else a["min_phase"])
-        return options, settings
+        if a["tol"] is not None:
+            options["tol"] = a["tol"]
+        resolved = MoreauJeanOptions(**options)
+        return options, dict(options, h=resolved.h, min_phase=resolved.min_phase)
+    if a["tol"] is not None:
+        raise InputError(f"tol is Moreau–Jean's error control; method '{method}' has rtol and atol")
+    a = dict(a, h=1e-4 if a["h"] is None else a["h"])
     rtol = (1e-12 if method == "event-driven" else 1e-6) if a["rtol"] is None else a["rtol"]
     require_positive("rtol", rtol)
     atol = (rtol if method == "event-driven" else rtol * 1e-3) if a["atol"] is None else a["atol"]

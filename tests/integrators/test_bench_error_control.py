@@ -1,0 +1,25 @@
+"""benchmarks/bench_error_control.py's quick mode: the rod at tol = 1e-3 and 1e-4 meets its
+tolerance against the event-driven reference, and its table, CSV and chart are written."""
+import csv
+import importlib.util
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_error_control", ROOT / "benchmarks" / "bench_error_control.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_quick_run_meets_the_tolerances_and_writes_its_files(tmp_path, capsys):
+    assert _bench().main(["--quick", "--out", str(tmp_path)]) == 0  # 1 if a tol run missed its tolerance
+    rows = list(csv.DictReader((tmp_path / "error_control.csv").open()))
+    assert [(r["knob"], float(r["value"])) for r in rows] == [("h", 1e-3), ("h", 1e-4), ("tol", 1e-3), ("tol", 1e-4)]
+    for r in rows:
+        if r["knob"] == "tol":
+            assert float(r["impact_error_s"]) <= float(r["impact_error_estimate_s"])
+    assert (tmp_path / "error_control.png").stat().st_size > 1000
+    assert "| tol = 0.0001 |" in capsys.readouterr().out
