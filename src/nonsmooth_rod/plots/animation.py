@@ -1,4 +1,4 @@
-"""Animations of any scene: bodies (disks, balls, rectangles, rods), lines, segments and contact forces.
+"""Animations of any scene: bodies (disks, balls, rectangles, polygons, rods), lines, segments and contact forces.
 
 How a body is drawn: from its `shape` in the scene file (disk/ball: a circle with a spoke to show
 the turn; rectangle; rod: a segment; rod-with-balls: a segment with a ball at each end, the centre
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
-from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge
+from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge, VertexOnEdge
 from ..validation import InputError
 
 
@@ -47,6 +47,11 @@ def _contact_parts(scene, body: int) -> list:
             parts.append((tuple(c.offset), c.radius))
         elif isinstance(c, SegmentEndOnEdge) and c.body == body:
             parts += [(tuple(c.edge_start), 0.0), (tuple(c.edge_end), 0.0)]
+        elif isinstance(c, VertexOnEdge):
+            if c.vertex_body == body:
+                parts.append((tuple(c.vertex), c.radius))
+            if c.edge_body == body:
+                parts += [(tuple(c.edge_start), 0.0), (tuple(c.edge_end), 0.0)]
         elif isinstance(c, DiskOnDisk):
             if c.body_a == body:
                 parts.append((tuple(c.offset_a), c.radius_a))
@@ -65,6 +70,8 @@ def body_outline(sf, body: int) -> list:
     if kind == "rectangle":
         a, b = shape["width"] / 2, shape["height"] / 2
         return [("polygon", [(-a, -b), (a, -b), (a, b), (-a, b)])]
+    if kind == "polygon":
+        return [("polygon", [tuple(p) for p in shape["vertices"]])]
     if kind == "rod":
         return [("segment", (-shape["length"] / 2, 0.0), (shape["length"] / 2, 0.0))]
     if kind == "rod-with-balls":
@@ -184,6 +191,12 @@ def contact_frames(scene, q: np.ndarray) -> list[tuple]:
             d = ca - cb
             n = d / max(np.linalg.norm(d), 1e-300)
             out.append((ca - c.radius_a * n, n, np.array([n[1], -n[0]])))
+        elif isinstance(c, VertexOnEdge):  # at the vertex (or the disk's touching point); force on its first body
+            j = 3 * c.bodies[0]
+            k = c.kinematics(q, np.zeros_like(q), q.size)
+            n, t = k.H_N[j: j + 2], k.H_T[j: j + 2]
+            point = _world(q, 3 * c.vertex_body, c.vertex) - c.radius * n if c.vertex_body >= 0 else np.array(c.vertex)
+            out.append((point, n, t))
         elif isinstance(c, (DiskOnSegment, SegmentEndOnEdge)):  # the touched feature's normal: from the kinematics
             j = 3 * c.body
             k = c.kinematics(q, np.zeros_like(q), q.size)
