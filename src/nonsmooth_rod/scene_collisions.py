@@ -144,7 +144,10 @@ def found_contacts(w, data, bodies, shapes: dict, lines: dict, segments: dict, d
             if not isinstance(group, str) or not group:
                 raise w.error(f"bodies.{body.name}.group", f"must be a name, got {group!r}")
             groups[body.name] = group
-        parts = collision_shapes(shapes.get(body.name) or {})
+        try:
+            parts = collision_shapes(shapes.get(body.name) or {})
+        except InputError as err:
+            raise w.error(f"bodies.{body.name}", f"its shape cannot collide: {err}") from None
         if collide and parts:
             colliding[body.name] = parts
     obstacles: dict = {**lines, **segments}
@@ -153,7 +156,10 @@ def found_contacts(w, data, bodies, shapes: dict, lines: dict, segments: dict, d
     if not colliding:
         return []
     never = _declared_pairs(declared, [b.name for b in bodies], obstacles)
-    return find_contacts(bodies, colliding, obstacles, laws, never=never, groups=groups)
+    try:
+        return find_contacts(bodies, colliding, obstacles, laws, never=never, groups=groups)
+    except InputError as err:
+        raise w.error("bodies", str(err)) from None
 
 
 __all__ = ["polygon_of", "polygon_inertia", "polygon_area", "collision_shapes", "pair_laws", "found_contacts",

@@ -235,6 +235,21 @@ STATUS_FONT_PT = 8
 _CHAR_WIDTH_EM = 0.602  # DejaVu Sans Mono, matplotlib's monospace
 
 
+# A scene with more contacts than this (shapes' candidate contacts: a box pair lists 32) is
+# drawn with only the contacts that ever touch: the others are open throughout.
+ALL_CONTACTS_UP_TO = 12
+
+
+def shown_contacts(result) -> list[tuple[int, str]]:
+    """(column, name) of the contacts the figure draws."""
+    names = list(result.contact_names)
+    if len(names) <= ALL_CONTACTS_UP_TO:
+        return list(enumerate(names))
+    return [(k, name) for k, name in enumerate(names)
+            if any(str(ph.mode) != "open" for ph in result.phases.get(name, []))
+            or np.any(result.trajectory.normal_force[:, k] != 0.0)]
+
+
 class StatusText:
     """The time and every contact's state, in a fixed number of lines that fit the frame's width:
     each entry padded to one width, so the text does not jump as states change."""
@@ -287,7 +302,8 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
         raise InputError("animating a run needs its scene file (result.scene_file) to know the bodies' shapes")
     tr = result.trajectory
     extent = scene_extent(result, sf)
-    status = StatusText(result.contact_names)
+    shown = shown_contacts(result)
+    status = StatusText([name for _, name in shown])
     fig, ax = _frame_figure(extent, status.lines, dpi)
     draw_lines(ax, sf, extent)
     bodies = _make_artists(ax, sf)
@@ -313,7 +329,7 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
                             for c, g in enumerate(geo)]) * scale
             arrows.set_offsets(pts)
             arrows.set_UVC(vec[:, 0], vec[:, 1])
-        label.set_text(status.text(tr.t[i], tr.modes[i]))
+        label.set_text(status.text(tr.t[i], [tr.modes[i, k] for k, _ in shown]))
         return []
 
     return animation.FuncAnimation(fig, update, frames=len(indices), interval=1000 / fps, blit=False)

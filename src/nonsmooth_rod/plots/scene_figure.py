@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
+from .animation import shown_contacts
 
 # The line plots colour bodies and contacts C0, C1, ... (blue, orange, green, red, ...): the phase
 # bar must not reuse a hue, or "stick" reads as "the first body". Its states are greys and
@@ -72,21 +73,6 @@ def _coordinates(ax, result, names) -> None:
     ax.set(xlabel="t [s]", ylabel="x (solid), y (dashed) [m]", title="centre-of-mass coordinates")
     right.set_ylabel("θ [rad] (dotted)")
     ax.legend(fontsize="x-small", loc="best")
-
-
-# A scene with more contacts than this (shapes' candidate contacts: a box pair lists 32) is
-# drawn with only the contacts that ever touch: the others are open throughout.
-ALL_CONTACTS_UP_TO = 12
-
-
-def shown_contacts(result) -> list[tuple[int, str]]:
-    """(column, name) of the contacts the figure draws."""
-    names = list(result.contact_names)
-    if len(names) <= ALL_CONTACTS_UP_TO:
-        return list(enumerate(names))
-    return [(k, name) for k, name in enumerate(names)
-            if any(str(ph.mode) != "open" for ph in result.phases.get(name, []))
-            or np.any(result.trajectory.normal_force[:, k] != 0.0)]
 
 
 def _forces(ax, result) -> None:
