@@ -200,3 +200,17 @@ def test_polyline_is_named_segments():
     assert list(chain) == ["ground.0", "ground.1"] and chain["ground.1"].b == (2.0, 1.0)
     with pytest.raises(nr.InputError, match="segment 'ground.0'.*length 0"):
         nr.Polyline([(0, 0), (0, 0)], name="ground")
+
+
+def test_the_event_driven_reference_runs_polygons_on_lines_and_refuses_segments_in_one_line():
+    """A box pushed along a floor stops after v0²/(2 μ g): its found corner contacts are points
+    on a line, which the event-driven method locates; on a segment it names what it lacks."""
+    box = _box("box", 1.0, 0.4, 0.2)
+    shape = {"box": nr.Polygon.rectangle(0.4, 0.2)}
+    contacts = find_contacts([box], shape, {"floor": nr.Line()}, nr.PairLaws(default=nr.ContactLaw.of(0.5)))
+    result = nr.simulate(nr.Scene([box], contacts), np.array([0.0, 0.1, 0.0]), np.array([0.5, 0.0, 0.0]), 0.3,
+                         "event-driven")
+    assert result.trajectory.q[-1, 0] == pytest.approx(0.5 ** 2 / (2 * 0.5 * G), rel=1e-8)
+    on_table = find_contacts([box], shape, {"table": nr.Segment((-1.0, 0.0), (1.0, 0.0))})
+    with pytest.raises(nr.InputError, match="'event-driven' does not handle VertexOnEdge contacts"):
+        nr.simulate(nr.Scene([box], on_table), np.array([0.0, 0.1, 0.0]), np.zeros(3), 0.1, "event-driven")
