@@ -150,8 +150,9 @@ def begin_step(params, qk, vk, f, model, work):
     for i in range(table.shape[0]):
         if broad and not candidate[i]:
             gaps[i], drifts[i] = math.inf, 0.0  # out of reach this step: no kinematics
-            hn[i, :] = 0.0
-            ht[i, :] = 0.0
+            for d in range(6):  # element by element: a row slice costs more, per listed contact
+                hn[i, d] = 0.0
+                ht[i, d] = 0.0
             continue
         gap, drift = contact_kinematics(table, index, i, qk, vk, hn[i], ht[i])
         if math.isnan(gap):
@@ -359,11 +360,14 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
     status = RUN_OK
+    broad, candidate = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS, work[10]  # as begin_step's broad phase
     for i in range(table.shape[0]):
         p_normal[k, i] = 0.0
         p_tangent[k, i] = 0.0
         state_rec[k, i] = 0
-        slip[k, i] = local_dot(ht[i], index, i, v_next) - table[i, C_SURFACE_VELOCITY]
+        slip[k, i] = -table[i, C_SURFACE_VELOCITY]
+        if not broad or candidate[i]:  # a contact out of reach has zero rows: no product to form
+            slip[k, i] += local_dot(ht[i], index, i, v_next)
     for i in range(table.shape[0]):
         grazing[i] = 0
     for a in range(na):
