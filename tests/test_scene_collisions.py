@@ -86,3 +86,11 @@ def test_the_example_block_slides_off_the_table():
     touched = sorted(k for k in result.contact_names if any(p.mode != "open" for p in result.phases[k]))
     assert touched == ["block.v0/table.side+", "block.v1/table.side+", "table.b/block.e0"]
     assert result.trajectory.q[-1, 1] < 0.8 and np.isfinite(result.trajectory.q).all()
+
+
+def test_a_rod_with_balls_collides_by_its_two_balls():
+    rod = {"name": "rod", "shape": "rod-with-balls", "ball_radius": 0.025, "rod_diameter": 0.01, "length": 0.3,
+           "density": 7800.0}
+    sf = _scene([rod], {"rod": [0.0, 0.025, 0.0]})
+    assert sf.contact_names == ["rod.s0/floor", "rod.s1/floor"]
+    assert [c.offset for c in sf.scene.contacts] == [(-0.15, 0.0), (0.15, 0.0)]
