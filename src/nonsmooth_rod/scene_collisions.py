@@ -56,7 +56,8 @@ def polygon_area(polygon: Polygon) -> float:
 
 
 def polygon_inertia(mass: float, polygon: Polygon) -> float:
-    """A uniform polygon about its centroid (the origin): m/(6A) Σ cross (xᵢ² + xᵢxᵢ₊₁ + xᵢ₊₁² + y...)/2."""
+    """A uniform polygon about its centroid (the origin): m/A · Σ cᵢ (xᵢ² + xᵢxᵢ₊₁ + xᵢ₊₁² + (the same
+    in y))/12, cᵢ = xᵢyᵢ₊₁ − xᵢ₊₁yᵢ."""
     pts = np.array(polygon.vertices)
     x, y = pts[:, 0], pts[:, 1]
     x1, y1 = np.roll(x, -1), np.roll(y, -1)

@@ -49,7 +49,8 @@ GAP_ROUNDOFF_ULPS = 64.0
 # Multiple of h² |g̈| within which a closed contact's gap counts as closed (persistence_margin).
 PERSISTENCE_FACTOR = 4.0
 # The broad phase runs when the scene lists more contacts between circles (disks, vertices,
-# edges, segments) than this: for a few, sorting the circles costs more than the kinematics it saves (measured: row of two balls 3.7 → 3.6 µs).
+# edges, segments) than this: for a few, sorting the circles costs more than the kinematics it
+# saves (measured: row of two balls 3.7 → 3.6 µs).
 BROAD_PHASE_MIN_PAIRS = 8
 # Added to every disk's reach in the broad phase (m): contacts placed exactly touching.
 BROAD_PHASE_SLACK = 1e-9

@@ -179,8 +179,8 @@ def _shape_name(body_name: str, k: int, n_shapes: int) -> str:
 
 
 def polygon_pair_contacts(poly_a, body_a, name_a, poly_b, body_b, name_b, law, tie_to_first=True):
-    """Every vertex of polygon a on every edge of polygon b and back (bodies or, with body −1,
-    ...): the first polygon's vertices keep ties at coincident corners when tie_to_first."""
+    """Every vertex of polygon a (of body_a) on every edge of polygon b (of body_b) and back; at a
+    corner exactly on a corner, the first polygon's vertices keep the tie when tie_to_first."""
     depth = DEPTH_FRACTION * min(poly_a.width, poly_b.width)
     found = []
     for (pv, bv, nv, pe, be, ne, wins) in ((poly_a, body_a, name_a, poly_b, body_b, name_b, tie_to_first),
@@ -270,7 +270,8 @@ def _colliders(bodies, shapes, obstacles):
         parts = list(body_shapes) if isinstance(body_shapes, (list, tuple)) else [body_shapes]
         for k, shape in enumerate(parts):
             if not isinstance(shape, (Polygon, Disk)):
-                raise InputError(f"shapes[{owner!r}]: a body's shape is a Polygon or a Disk, got {type(shape).__name__}")
+                raise InputError(f"shapes[{owner!r}]: a body's shape is a Polygon or a Disk, "
+                                 f"got {type(shape).__name__}")
             found.append((_shape_name(owner, k, len(parts)), names.index(owner), shape, owner))
     found.sort(key=lambda c: c[1])
     for owner, obstacle in obstacles.items():
