@@ -118,13 +118,16 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
     for j in range(pair_contact.shape[0]):
         candidate[pair_contact[j]] = was_closed[pair_contact[j]]
     order = np.argsort(x)
+    widest = 0.0  # circles of different sizes (a vertex, an edge): stop the sweep at the widest's reach
+    for d in range(n):
+        widest = max(widest, reach[d])
     for a in range(n):
         da = order[a]
         for b in range(a + 1, n):
             db = order[b]
-            if x[db] - x[da] > reach[da] + reach[db]:
+            if x[db] - x[da] > reach[da] + widest:
                 break
-            if abs(y[db] - y[da]) > reach[da] + reach[db]:
+            if abs(x[db] - x[da]) > reach[da] + reach[db] or abs(y[db] - y[da]) > reach[da] + reach[db]:
                 continue
             key = min(da, db) * n + max(da, db)
             j = np.searchsorted(pair_keys, key)

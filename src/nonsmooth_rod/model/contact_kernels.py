@@ -39,9 +39,12 @@ KIND_VERTEX_ON_EDGE, KIND_FIXED_VERTEX_ON_EDGE = 4, 5
 # owner's frame; world when fixed), its length in C_SEGMENT_LENGTH.
 C_CONE_1X, C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_TIE_WINS, C_DEPTH_LIMIT = range(19, 25)
 N_CONTACT_COLUMNS = 25
-# A vertex within SEAM_TOL × the edge's length of an end of the edge is at that end; an edge
-# normal within CONE_TOL (a sine) of a boundary of the vertex's normal cone is on it.
-SEAM_TOL, CONE_TOL = 1e-9, 1e-9
+# A vertex within SEAM_TOL × the edge's length of an end of the edge is at that end. An edge
+# normal within FACE_TOL (a sine: 1°) of a boundary of the vertex's normal cone is on it: the
+# vertex's edge and the edge face each other, and both of its ends may touch — counting only the
+# nearer end of two faces tilted by less would drop a face's second support as it rocks (the far
+# end, just outside its cone, is then farther than the near one by the tilt: no wrong contact).
+SEAM_TOL, FACE_TOL = 1e-9, 0.0175
 
 
 @jitable
@@ -204,15 +207,15 @@ def _vertex_feature_valid(row, along, length, dx, dy, ca, sa):
     n1x, n1y = ca * row[C_CONE_1X] - sa * row[C_CONE_1Y], sa * row[C_CONE_1X] + ca * row[C_CONE_1Y]
     n2x, n2y = ca * row[C_CONE_2X] - sa * row[C_CONE_2Y], sa * row[C_CONE_2X] + ca * row[C_CONE_2Y]
     c1, c2 = n1x * dy - n1y * dx, dx * n2y - dy * n2x
-    if c1 < -CONE_TOL or c2 < -CONE_TOL:
+    if c1 < -FACE_TOL or c2 < -FACE_TOL:
         return False
     tol = SEAM_TOL * length
-    if c1 <= CONE_TOL and n1x * dx + n1y * dy > 0.0:  # the previous edge face to face: it runs along +τ
+    if c1 <= FACE_TOL and n1x * dx + n1y * dy > 0.0:  # the previous edge face to face: it runs along +τ
         if along > length - tol:
             return False
         if along < tol and row[C_TIE_WINS] == 0.0:
             return False
-    if c2 <= CONE_TOL and n2x * dx + n2y * dy > 0.0:  # the next edge face to face: it runs along −τ
+    if c2 <= FACE_TOL and n2x * dx + n2y * dy > 0.0:  # the next edge face to face: it runs along −τ
         if along < tol:
             return False
         if along > length - tol and row[C_TIE_WINS] == 0.0:
