@@ -14,7 +14,8 @@ __version__ = "0.2.0"
 from .driver import StopAtImpact, simulate
 from .model.body import RigidBody
 from .model.contacts import (DiskOnDisk, DiskOnLine, DiskOnSegment, Line, PointOnLine, PointOnSegment, Segment,
-                             SegmentEndOnEdge)
+                             SegmentEndOnEdge, VertexOnEdge)
+from .model.collision import Disk, PairLaws, Polygon, Polyline, find_contacts
 from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce
 from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
 from .model.scene import Scene
@@ -44,7 +45,8 @@ SimulationResult.animate = _animate
 
 __all__ = [
     "__version__", "simulate", "StopAtImpact", "Scene", "RigidBody", "Line", "DiskOnLine", "PointOnLine",
-    "Segment", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge",
+    "Segment", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "VertexOnEdge",
+    "Polygon", "Disk", "Polyline", "PairLaws", "find_contacts",
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
     "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",

@@ -109,6 +109,13 @@ def _contact_data(contact, bodies, lines, segments) -> dict:
                 "offset_a": list(contact.offset_a), "offset_b": list(contact.offset_b), "law": law}
     if hasattr(contact, "segment"):
         return _segment_contact_data(contact, bodies, segments, law)
+    if hasattr(contact, "vertex_body"):  # a VertexOnEdge (found between shapes), described; null: fixed
+        return {"name": contact.name, "kind": "vertex-on-edge", "law": law,
+                "vertex_body": bodies[contact.vertex_body] if contact.vertex_body >= 0 else None,
+                "edge_body": bodies[contact.edge_body] if contact.edge_body >= 0 else None,
+                **{k: _plain(getattr(contact, k)) for k in ("vertex", "edge_start", "edge_end", "cone", "radius",
+                                                            "tie_wins")},
+                "depth_limit": contact.depth_limit if math.isfinite(contact.depth_limit) else None}
     line = contact.line
     name = next((n for n, known in lines.items() if known == line), f"line{len(lines)}")
     lines[name] = line

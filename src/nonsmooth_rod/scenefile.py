@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .integrators import METHODS
+from . import scene_collisions
 from .model import shapes
 from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
@@ -33,7 +34,7 @@ except ModuleNotFoundError:  # Python 3.10: the backport (dependency `tomli; pyt
     import tomli as tomllib
 
 SCHEMA = "nonsmooth-rod/scene/1"
-SHAPES = ("disk", "ball", "rectangle", "rod", "rod-with-balls")
+SHAPES = ("disk", "ball", "rectangle", "polygon", "rod", "rod-with-balls")
 CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk", "disk-on-segment", "point-on-segment",
                  "segment-end-on-edge")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_+\-]{1,200}")  # fullmatch: no trailing newline
@@ -42,9 +43,10 @@ _REQUIRED = object()
 MAX_DEPTH = 16  # tables and lists nest at most this deep (a scene needs 4)
 
 TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "segments", "contacts", "forces",
-            "initial", "simulation")
+            "initial", "simulation", "laws")
 BODY_KEYS = ("name", "mass", "inertia", "shape", "density", "thickness", "radius", "width", "height",
-             "length", "ball_radius", "rod_diameter")
+             "length", "ball_radius", "rod_diameter", "vertices", "collide", "group")
+COLLISION_KEYS = ("collide", "group")  # scene_collisions.py: not dimensions of a shape
 LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length")
 SEGMENT_KEYS = ("name", "a", "b")
 LAW_KEYS = ("mu_s", "mu_d", "restitution")
@@ -217,13 +219,14 @@ def _shape_mass(w, t, key, shape) -> float:
 
 SHAPE_KEYS = {None: (), "disk": ("radius", "density", "thickness"), "ball": ("radius", "density"),
               "rectangle": ("width", "height", "density", "thickness"), "rod": ("length",),
+              "polygon": ("vertices", "density", "thickness"),
               "rod-with-balls": ("ball_radius", "rod_diameter", "length", "density")}
 
 
 def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
     """(drawing shape, mass, inertia) from `shape` and its dimensions; None where the shape gives none."""
     shape = _text(w, t, "shape", key, None, SHAPES) if "shape" in t else None
-    stray = [k for k in t if k in BODY_KEYS[4:] and k not in SHAPE_KEYS[shape]]
+    stray = [k for k in t if k in BODY_KEYS[4:] and k not in SHAPE_KEYS[shape] and k not in COLLISION_KEYS]
     if stray:
         takes = ", ".join(SHAPE_KEYS[shape]) or "no dimensions (give mass and inertia, or a shape)"
         raise w.error(f"{key}.{stray[0]}", f"not a dimension of {'a ' + shape if shape else 'a body without shape'}: "
@@ -237,6 +240,8 @@ def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
         except InputError as err:
             raise w.error(key, str(err)) from None
         return {"shape": shape, **{k: dims[k] for k in ("ball_radius", "rod_diameter", "length")}}, mass, inertia
+    if shape == "polygon":
+        return _polygon_shape(w, t, key)
     needs = {"disk": ("radius",), "ball": ("radius",), "rectangle": ("width", "height"), "rod": ("length",)}[shape]
     dims = {k: _number(w, t, k, key, positive=True) for k in needs}
     if "mass" in t and "density" in t:
@@ -245,6 +250,20 @@ def _shape_of(w, t, key) -> tuple[dict, float | None, float | None]:
     inertia = {"disk": shapes.disk_inertia, "ball": shapes.ball_inertia, "rectangle": shapes.rectangle_inertia,
                "rod": shapes.thin_rod_inertia}[shape](mass, *dims.values())
     return {"shape": shape, **dims}, mass, inertia
+
+
+def _polygon_shape(w, t, key):
+    """A convex polygon body: vertices about its centre of mass; mass, or density × area × thickness."""
+    polygon = scene_collisions.polygon_of(w, t, key)
+    if "mass" in t and "density" in t:
+        raise w.error(f"{key}.density", "give mass or density, not both")
+    if "mass" in t:
+        mass = _number(w, t, "mass", key, positive=True)
+    else:
+        mass = (_number(w, t, "density", key, positive=True) * scene_collisions.polygon_area(polygon)
+                * _number(w, t, "thickness", key, positive=True))
+    return ({"shape": "polygon", "vertices": [list(p) for p in polygon.vertices]}, mass,
+            scene_collisions.polygon_inertia(mass, polygon))
 
 
 def _finite_shape_of(w, t, key):
@@ -481,6 +500,8 @@ def _check_overlap(w, scene, q0, v0) -> None:
         except InputError as err:
             raise w.error(f"contacts.{c.name}", f"at the initial state: {err}") from None
         gap = kin.gap
+        if gap == math.inf:  # found shapes' features that are not the touching pair
+            continue
         if not all(math.isfinite(x) for x in (gap, kin.drift_N, kin.drift_T)):
             raise w.error("initial", f"contact {c.name!r}: the initial state overflows its kinematics "
                                      "(positions or velocities far too large)")
@@ -673,6 +694,7 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     bodies, body_names, shapes = _bodies(w, data)
     lines, segments = _lines(w, data), _segments(w, data)
     contacts = _contacts(w, data, body_names, lines, segments)
+    contacts += scene_collisions.found_contacts(w, data, bodies, shapes, lines, segments, contacts)
     forces = _forces(w, data, body_names)
     try:
         with np.errstate(all="ignore"):

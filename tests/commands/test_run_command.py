@@ -36,8 +36,23 @@ def modes(summary, contact):
 
 def test_every_shipped_scene_has_a_test():
     tested = {"bouncing_ball", "block_on_incline", "pushed_block", "disk_on_incline", "belt_oscillator",
-              "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod", "ball_off_table"}
+              "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod", "ball_off_table",
+              "box_off_table"}
     assert {p.stem for p in SCENES.glob("*.toml")} == tested
+
+
+def test_box_off_table_pivots_where_the_moment_of_friction_is_no_longer_balanced(tmp_path):
+    """Found contacts through the CLI: the block's back corner lifts (the pivot on the table's
+    edge starts) when its centre of mass is μd h/2 before the edge, both contacts sliding."""
+    s, c = run(tmp_path, "box_off_table")
+    assert modes(s, "block.v1/table.side+") == ["slip+", "open"]
+    assert modes(s, "block.v0/table.side+") == ["slip+", "open"]
+    assert modes(s, "table.b/block.e0") == ["open", "slip+", "open"] and modes(s, "block.v3/floor") == ["open"]
+    mu_d, height, x0, v0 = 0.2, 0.2, -0.25, 1.2
+    a = mu_d * 9.81
+    t_pivot = (v0 - math.sqrt(v0 * v0 - 2 * a * (-mu_d * height / 2 - x0))) / a
+    assert s["phases"]["block.v0/table.side+"][0]["t_end"] == pytest.approx(t_pivot, abs=3 * H)
+    assert c["block.y"][-1] < 0.5  # off the table (its top at 0.8 m)
 
 
 def test_bouncing_ball_impact_times(tmp_path):

@@ -9,7 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from nonsmooth_rod.model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
+from nonsmooth_rod.model.contacts import (DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge,
+                                         VertexOnEdge)
+from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.packing import contact_kinematics, pack_contacts
 from nonsmooth_rod.validation import InputError
 
@@ -226,3 +228,126 @@ def test_segment_end_on_an_edge_is_the_derivatives_of_its_geometry(label, contac
     gap, drift = contact_kinematics(table, index, 0, q, v, hn, ht)
     np.testing.assert_allclose([gap, drift, *hn[:3], *ht[:3]], [k.gap, k.drift_N, *k.H_N, *k.H_T], rtol=1e-13,
                                atol=1e-14)
+
+
+# --- a vertex (or disk) on an edge, both sides moving or either fixed --------------------------------
+EDGE = ((-0.3, 0.1), (0.5, -0.1))  # the edge's owner frame; its outward normal is τ turned by −90°
+VERTEX = (0.15, -0.1)  # the vertex owner's frame
+# −n of the edge in the vertex's frame: with the vertex body turned by 0.2 rad from the edge body,
+# it is −n0 turned by −0.2; a cone of ±60° around it contains it
+
+
+def _vertex_on_edge_case(vertex_body, edge_body, radius):
+    t0 = np.subtract(EDGE[1], EDGE[0]) / np.linalg.norm(np.subtract(EDGE[1], EDGE[0]))
+    minus_n0 = np.array([-t0[1], t0[0]])
+    centre = _rotate(-0.2 if vertex_body >= 0 and edge_body >= 0 else 0.0, minus_n0)
+    cone = (tuple(_rotate(-math.pi / 3, centre)), tuple(_rotate(math.pi / 3, centre)))
+    contact = VertexOnEdge(vertex_body, VERTEX, edge_body, *EDGE, cone=None if radius else cone, radius=radius)
+    n_bodies = 1 + (vertex_body >= 0 and edge_body >= 0)
+
+    def place(q):
+        theta_b = q[3 * edge_body + 2] if edge_body >= 0 else 0.0
+        if vertex_body >= 0 and edge_body >= 0:
+            q[3 * vertex_body + 2] = theta_b + 0.2
+        if vertex_body < 0 and edge_body >= 0:
+            q[2] = 0.0 if abs(q[2]) > 0.5 else q[2]  # −n within the fixed vertex's cone: turned < 60°
+        origin = q[3 * edge_body: 3 * edge_body + 2] if edge_body >= 0 else np.zeros(2)
+        start, end = (origin + _rotate(theta_b, e) for e in EDGE)
+        tau = (end - start) / np.linalg.norm(end - start)
+        point = start + 0.4 * (end - start) + (radius + 0.05 * q[0]) * np.array([tau[1], -tau[0]])
+        if vertex_body >= 0:
+            q[3 * vertex_body: 3 * vertex_body + 2] = point - _rotate(q[3 * vertex_body + 2], VERTEX)
+        else:
+            contact.vertex = tuple(point)
+    return contact, n_bodies, place
+
+
+def _vertex_geometry(c, q):
+    """(normal, touching point of the vertex side, foot on the edge, gap) from plain geometry."""
+    def frame(body):
+        return (q[3 * body: 3 * body + 2], q[3 * body + 2]) if body >= 0 else (np.zeros(2), 0.0)
+    (oa, tha), (ob, thb) = frame(c.vertex_body), frame(c.edge_body)
+    p = oa + _rotate(tha, c.vertex) if c.vertex_body >= 0 else np.array(c.vertex)
+    e0, e1 = ob + _rotate(thb, c.edge_start), ob + _rotate(thb, c.edge_end)
+    tau = (e1 - e0) / np.linalg.norm(e1 - e0)
+    n = np.array([tau[1], -tau[0]])
+    foot = e0 + np.dot(p - e0, tau) * tau
+    return n, p - c.radius * n, foot, float(np.dot(n, p - e0)) - c.radius
+
+
+VERTEX_CASES = [("disk on a moving edge", 0, 1, 0.07), ("vertex on a moving edge", 1, 0, 0.0),
+                ("vertex on a fixed edge", 0, -1, 0.0), ("disk on a fixed edge", 0, -1, 0.05),
+                ("fixed vertex on an edge", -1, 0, 0.0)]
+
+
+@pytest.mark.parametrize("label, vertex_body, edge_body, radius", VERTEX_CASES, ids=[c[0] for c in VERTEX_CASES])
+def test_a_vertex_on_an_edge_is_the_derivatives_of_its_geometry(label, vertex_body, edge_body, radius):
+    contact, n_bodies, place = _vertex_on_edge_case(vertex_body, edge_body, radius)
+    rng = np.random.default_rng(25)
+    for _ in range(20):
+        q, v = _random_state(rng, n_bodies, place)
+        k = contact.kinematics(q, v, q.size)
+        plus, minus = _along(contact, q, v, 1), _along(contact, q, v, -1)
+        scale = 1.0 + np.abs(v).max() ** 2
+        n, pa, foot, gap = _vertex_geometry(contact, q)
+        assert k.gap == pytest.approx(gap, abs=1e-12)
+        t = np.array([n[1], -n[0]])
+        rel = -_material_velocity(q, v, contact.edge_body, foot) if contact.edge_body >= 0 else 0.0
+        if contact.vertex_body >= 0:
+            rel = rel + _material_velocity(q, v, contact.vertex_body, pa)
+        assert k.H_T @ v == pytest.approx(float(np.dot(t, rel)), rel=1e-7, abs=1e-7 * scale)
+        assert k.H_N @ v == pytest.approx((plus.gap - minus.gap) / (2 * EPS), rel=1e-7, abs=1e-7 * scale)
+        assert k.drift_N == pytest.approx((plus.H_N @ v - minus.H_N @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+        assert k.drift_T == pytest.approx((plus.H_T @ v - minus.H_T @ v) / (2 * EPS), rel=1e-6, abs=1e-6 * scale)
+        table, index = pack_contacts([contact], n_bodies)
+        hn, ht = np.zeros(6), np.zeros(6)
+        packed_gap, drift = contact_kinematics(table, index, 0, q, v, hn, ht)
+        np.testing.assert_allclose([packed_gap, drift], [k.gap, k.drift_N], rtol=1e-13, atol=1e-14)
+
+
+SQUARE = ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5))  # counter-clockwise; edge i runs from vertex i
+
+
+def _box_pair_contacts(upper_wins_ties: bool):
+    """Every vertex of a unit box (body 0, above) on every edge of another (body 1, below) and back."""
+    from nonsmooth_rod.model.collision import Polygon, polygon_pair_contacts
+
+    box = Polygon(SQUARE)
+    return polygon_pair_contacts(box, 0, "upper", box, 1, "lower", ContactLaw(), tie_to_first=upper_wins_ties)
+
+
+@pytest.mark.parametrize("upper_first", [True, False])
+def test_flat_box_on_flat_box_of_the_same_width_touches_once_per_corner(upper_first):
+    """The classic pitfall: corners exactly on corners. One contact per corner, normal +y."""
+    contacts = _box_pair_contacts(upper_first)
+    q = np.array([0.0, 1.0, 0.0, 0.0, 0.0, 0.0])
+    touching = [(c.name, c.kinematics(q, np.zeros(6), 6)) for c in contacts]
+    touching = [(name, k) for name, k in touching if k.gap <= 1e-12]
+    assert len(touching) == 2, [name for name, _ in touching]
+    for _, k in touching:
+        assert k.gap == pytest.approx(0.0, abs=1e-15)
+        np.testing.assert_allclose(k.H_N[:2], [0.0, 1.0], atol=1e-15)  # pushes the upper box up
+        np.testing.assert_allclose(k.H_N[3:5], [0.0, -1.0], atol=1e-15)
+    q[0] = 0.2  # shifted: the upper box's left corner on the lower's top, the lower's right corner under the upper
+    touching = sorted(c.name for c in contacts if c.kinematics(q, np.zeros(6), 6).gap <= 1e-12)
+    assert touching == ["lower.v2/upper.e0", "upper.v0/lower.e2"]
+
+
+def test_a_vertex_whose_foot_leaves_the_edge_is_open_not_wrong():
+    contacts = {c.name: c for c in _box_pair_contacts(True)}
+    q = np.array([1.2, 1.0, 0.0, 0.0, 0.0, 0.0])  # the upper box entirely beside the lower, at its height
+    for name in ("upper.v0/lower.e2", "upper.v0/lower.e1"):  # beyond the top; a corner beside a side
+        assert contacts[name].kinematics(q, np.zeros(6), 6).gap == math.inf
+    q = np.array([0.9999, 1.0, 0.0, 0.0, 0.0, 0.0])  # overlapping by 0.1 mm: on the top, not pushed sideways
+    kin = {name: c.kinematics(q, np.zeros(6), 6) for name, c in contacts.items()}
+    assert kin["upper.v0/lower.e2"].gap == pytest.approx(0.0, abs=1e-15)
+    assert kin["upper.v0/lower.e1"].gap == math.inf  # the corner is at the side's end, the sides face away
+
+
+def test_bad_vertex_on_edge_input_is_one_line():
+    with pytest.raises(InputError, match="edge of length 0"):
+        VertexOnEdge(0, (0.0, 0.0), 1, (1.0, 1.0), (1.0, 1.0), cone=((1.0, 0.0), (0.0, 1.0)))
+    with pytest.raises(InputError, match="cone"):
+        VertexOnEdge(0, (0.0, 0.0), 1, (0.0, 0.0), (1.0, 1.0))
+    with pytest.raises(InputError, match="vertex_body and edge_body must differ"):
+        VertexOnEdge(1, (0.0, 0.0), 1, (0.0, 0.0), (1.0, 1.0), radius=0.1)

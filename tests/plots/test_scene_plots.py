@@ -115,7 +115,8 @@ def _ball_row(n: int, name_length: int = 12):
 
     names = [f"ball{i}" for i in range(n)]
     data = {"schema": "nonsmooth-rod/scene/1",
-            "bodies": [{"name": b, "shape": "disk", "radius": 0.05, "mass": 1.0} for b in names],
+            "bodies": [{"name": b, "shape": "disk", "radius": 0.05, "mass": 1.0, "collide": False}  # only the
+                       for b in names],  # declared contacts: one each
             "lines": [{"name": "floor"}],
             "contacts": [{"kind": "disk-on-line", "name": f"{b}-on-floor".ljust(name_length, "x"), "body": b,
                           "line": "floor", "radius": 0.05, "law": {"mu_s": 0.3, "mu_d": 0.2}} for b in names],

@@ -22,7 +22,7 @@ MAX_OUTPUT_BYTES = 4 * 2**30
 # method name → (module, integrator class, options class, contact relations it handles)
 METHODS = {
     "moreau-jean": ("moreau_jean", "MoreauJean", "MoreauJeanOptions", ("DiskOnLine", "DiskOnDisk", "DiskOnSegment",
-                                                                             "SegmentEndOnEdge")),
+                                                                             "SegmentEndOnEdge", "VertexOnEdge")),
     "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine",)),
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
 }

@@ -37,8 +37,7 @@ def _inlined(function):
 
     return numba.njit(cache=True, inline="always")(function)
 from ..model.forces import accumulate_forces
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
-                             KIND_DISK_ON_DISK,
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A,
                              contact_kinematics, local_dot)
 from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
@@ -51,8 +50,9 @@ ACTIVATION_ROUNDOFF = 1e-12
 GAP_ROUNDOFF_ULPS = 64.0
 # Multiple of h² |g̈| within which a closed contact's gap counts as closed (persistence_margin).
 PERSISTENCE_FACTOR = 4.0
-# The broad phase runs when the scene lists more disk–disk contacts than this: for a few, sorting
-# the disks costs more than the kinematics it saves (measured: row of two balls 3.7 → 3.6 µs).
+# The broad phase runs when the scene lists more contacts between circles (disks, vertices,
+# edges, segments) than this: for a few, sorting the circles costs more than the kinematics it
+# saves (measured: row of two balls 3.7 → 3.6 µs).
 BROAD_PHASE_MIN_PAIRS = 8
 # Added to every disk's reach in the broad phase (m): contacts placed exactly touching.
 BROAD_PHASE_SLACK = 1e-9
@@ -105,33 +105,44 @@ def persistence_margin(h, drift, free_acceleration):
 def _disk_reach(h, q, v, disks, disk_body, x, y, reach):
     """World centres of the disks and how far each can reach this step (radius + h · speed)."""
     for d in range(disks.shape[0]):
+        ox, oy = disks[d, 0], disks[d, 1]
+        if disk_body[d] < 0:  # a fixed circle (a segment, a segment's end)
+            x[d], y[d], reach[d] = ox, oy, disks[d, 2] + BROAD_PHASE_SLACK
+            continue
         j = 3 * disk_body[d]
         c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
-        ox, oy = disks[d, 0], disks[d, 1]
         x[d] = q[j] + c * ox - s * oy
         y[d] = q[j + 1] + s * ox + c * oy
-        speed = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1]) + abs(v[j + 2]) * math.sqrt(ox * ox + oy * oy)
+        # the fastest point of the circle: an edge's end turns faster than its middle
+        lever = math.sqrt(ox * ox + oy * oy) + disks[d, 2]
+        speed = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1]) + abs(v[j + 2]) * lever
         reach[d] = disks[d, 2] + h * speed + BROAD_PHASE_SLACK
 
 
 @jit
 def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate):
-    """Mark the disk–disk contacts that can act this step: sort the disks along x, and test only
-    pairs whose centres are within their reach (sweep and prune), plus the contacts closed last
-    step. O(disks log disks + pairs in reach), whatever the number of listed contacts."""
+    """Mark the contacts that can act this step: sort the feature circles (packing.pack_disk_pairs)
+    along x, and test only pairs whose centres are within their reach (sweep and prune), plus
+    the contacts closed last step and those outside the broad phase (on lines).
+    O(circles log circles + pairs in reach), whatever the number of listed contacts."""
     n = disks.shape[0]
     x, y, reach = np.empty(n), np.empty(n), np.empty(n)
     _disk_reach(h, q, v, disks, disk_body, x, y, reach)
     for i in range(candidate.shape[0]):
-        candidate[i] = was_closed[i]
+        candidate[i] = 1
+    for j in range(pair_contact.shape[0]):
+        candidate[pair_contact[j]] = was_closed[pair_contact[j]]
     order = np.argsort(x)
+    widest = 0.0  # circles of different sizes (a vertex, an edge): stop the sweep at the widest's reach
+    for d in range(n):
+        widest = max(widest, reach[d])
     for a in range(n):
         da = order[a]
         for b in range(a + 1, n):
             db = order[b]
-            if x[db] - x[da] > reach[da] + reach[db]:
+            if x[db] - x[da] > reach[da] + widest:
                 break
-            if abs(y[db] - y[da]) > reach[da] + reach[db]:
+            if abs(x[db] - x[da]) > reach[da] + reach[db] or abs(y[db] - y[da]) > reach[da] + reach[db]:
                 continue
             key = min(da, db) * n + max(da, db)
             j = np.searchsorted(pair_keys, key)
@@ -156,9 +167,9 @@ def begin_step(params, qk, vk, f, model, work):
         broad_phase(h, qk, vk, model[8], model[9], model[10], model[11], was_closed, candidate)
     na = 0
     for i in range(table.shape[0]):
-        if broad and index[i, CI_KIND] == KIND_DISK_ON_DISK and not candidate[i]:
+        if broad and not candidate[i]:
             gaps[i], drifts[i] = math.inf, 0.0  # out of reach this step: no kinematics
-            for d in range(6):  # scalar: a slice is a view, ~20 ns for each of a pile's pairs
+            for d in range(6):  # element by element: a row slice costs more, per listed contact
                 hn[i, d] = 0.0
                 ht[i, d] = 0.0
             continue
@@ -393,11 +404,14 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
     status = RUN_OK
+    broad, candidate = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS, work[10]  # as begin_step's broad phase
     for i in range(table.shape[0]):
         p_normal[k, i] = 0.0
         p_tangent[k, i] = 0.0
         state_rec[k, i] = 0
-        slip[k, i] = local_dot(ht[i], index, i, v_next) - table[i, C_SURFACE_VELOCITY]
+        slip[k, i] = -table[i, C_SURFACE_VELOCITY]
+        if not broad or candidate[i]:  # a contact out of reach has zero rows: no product to form
+            slip[k, i] += local_dot(ht[i], index, i, v_next)
     for i in range(table.shape[0]):
         grazing[i] = 0
     for a in range(na):

@@ -22,13 +22,29 @@ import math
 from .._jit import jitable
 
 KIND_DISK_ON_LINE, KIND_DISK_ON_DISK, KIND_DISK_ON_SEGMENT, KIND_SEGMENT_END_ON_EDGE = 0, 1, 2, 3
+# A vertex (or disk) of body a on an edge of body b or of a fixed segment (model/collision.py);
+# a fixed vertex (a segment's end) on an edge of body a.
+KIND_VERTEX_ON_EDGE, KIND_FIXED_VERTEX_ON_EDGE = 4, 5
 # Float columns of a contact row. A segment stores its end a in C_LINE_P*, its unit direction
 # a → b in C_T*, its left normal in C_N* and its length in C_SEGMENT_LENGTH. A segment's end on
 # a body's edge: the end point in C_LINE_P*, the edge's start in C_OFF_A*, its unit direction
 # (body frame) in C_EDGE_T* and its length in C_SEGMENT_LENGTH.
 (C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_OFF_BX, C_OFF_BY, C_RADIUS_B, C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_TX,
  C_TY, C_SURFACE_VELOCITY, C_MU_S, C_MU_D, C_RESTITUTION, C_SEGMENT_LENGTH, C_EDGE_TX, C_EDGE_TY) = range(19)
-N_CONTACT_COLUMNS = 19
+# A vertex on an edge (KIND_VERTEX_ON_EDGE, KIND_FIXED_VERTEX_ON_EDGE): the vertex in C_OFF_A*
+# (body frame; a fixed vertex: world, in C_LINE_P*), the outward normals of its previous and
+# next edges in C_CONE_1*, C_CONE_2* (its normal cone; the vertex owner's frame), whether it
+# keeps a tie at coincident corners (C_TIE_WINS, 1 or 0), the deepest penetration still counted
+# (C_DEPTH_LIMIT); the edge's start in C_OFF_B* and unit direction in C_EDGE_T* (the edge
+# owner's frame; world when fixed), its length in C_SEGMENT_LENGTH.
+C_CONE_1X, C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_TIE_WINS, C_DEPTH_LIMIT = range(19, 25)
+N_CONTACT_COLUMNS = 25
+# A vertex within SEAM_TOL × the edge's length of an end of the edge is at that end. An edge
+# normal within FACE_TOL (a sine: 1°) of a boundary of the vertex's normal cone is on it: the
+# vertex's edge and the edge face each other, and both of its ends may touch — counting only the
+# nearer end of two faces tilted by less would drop a face's second support as it rocks (the far
+# end, just outside its cone, is then farther than the near one by the tilt: no wrong contact).
+SEAM_TOL, FACE_TOL = 1e-9, 0.0175
 
 
 @jitable
@@ -172,6 +188,83 @@ def _segment_end_on_edge(row, body, q, v, hn, ht):
 
 
 @jitable
+def _frame(body, q, v, row, ox_col, oy_col):
+    """(cos θ, sin θ, world point of the body-frame offset in the row, its lever, velocity and ω
+    of the body) — the world itself (offset = world point, at rest) for body −1."""
+    if body < 0:
+        return 1.0, 0.0, row[ox_col], row[oy_col], 0.0, 0.0, 0.0, 0.0, 0.0
+    j = 3 * body
+    c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
+    rx, ry = c * row[ox_col] - s * row[oy_col], s * row[ox_col] + c * row[oy_col]
+    return c, s, q[j] + rx, q[j + 1] + ry, rx, ry, v[j], v[j + 1], v[j + 2]
+
+
+@jitable
+def _vertex_feature_valid(row, along, length, dx, dy, ca, sa):
+    """The feature-pair rule of a vertex (radius 0) on an edge: −n (dx, dy) in the vertex's
+    normal cone; where it lies on a boundary of the cone, the face-to-face edges must overlap,
+    and a vertex at the edge's end (a corner on a corner) keeps the tie only if C_TIE_WINS."""
+    n1x, n1y = ca * row[C_CONE_1X] - sa * row[C_CONE_1Y], sa * row[C_CONE_1X] + ca * row[C_CONE_1Y]
+    n2x, n2y = ca * row[C_CONE_2X] - sa * row[C_CONE_2Y], sa * row[C_CONE_2X] + ca * row[C_CONE_2Y]
+    c1, c2 = n1x * dy - n1y * dx, dx * n2y - dy * n2x
+    if c1 < -FACE_TOL or c2 < -FACE_TOL:
+        return False
+    tol = SEAM_TOL * length
+    if c1 <= FACE_TOL and n1x * dx + n1y * dy > 0.0:  # the previous edge face to face: it runs along +τ
+        if along > length - tol:
+            return False
+        if along < tol and row[C_TIE_WINS] == 0.0:
+            return False
+    if c2 <= FACE_TOL and n2x * dx + n2y * dy > 0.0:  # the next edge face to face: it runs along −τ
+        if along < tol:
+            return False
+        if along > length - tol and row[C_TIE_WINS] == 0.0:
+            return False
+    return True
+
+
+@jitable
+def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
+    """A vertex (or a disk of radius C_RADIUS_A) of `point_body` (−1: fixed) on a straight edge
+    of `edge_body` (−1: fixed), the edge's outward normal n = τ turned by −90° (a CCW outline).
+    Gap n·(P − E) − r; the edge's touching point is the foot Q = E + (τ·(P − E)) τ. An infinite
+    gap: the pair is not the touching one (the foot beyond the edge, a wrong cone, too deep)."""
+    ca, sa, px, py, rpx, rpy, vax, vay, om_a = _frame(point_body, q, v, row, C_OFF_AX, C_OFF_AY)
+    if point_body < 0:
+        px, py = row[C_LINE_PX], row[C_LINE_PY]
+    cb, sb, ex, ey, rex, rey, vbx, vby, om_b = _frame(edge_body, q, v, row, C_OFF_BX, C_OFF_BY)
+    tx, ty = cb * row[C_EDGE_TX] - sb * row[C_EDGE_TY], sb * row[C_EDGE_TX] + cb * row[C_EDGE_TY]
+    nx, ny = ty, -tx
+    r, length = row[C_RADIUS_A], row[C_SEGMENT_LENGTH]
+    dx, dy = px - ex, py - ey
+    along = dx * tx + dy * ty
+    gap = dx * nx + dy * ny - r
+    rqx, rqy = rex + along * tx, rey + along * ty
+    if point_body >= 0:
+        _fill_rows(hn, ht, 0, nx, ny, rpx - r * nx, rpy - r * ny, 1.0)
+        if edge_body >= 0:
+            _fill_rows(hn, ht, 1, nx, ny, rqx, rqy, -1.0)
+        else:
+            _clear_side(hn, ht, 1)
+    else:
+        _fill_rows(hn, ht, 0, nx, ny, rqx, rqy, -1.0)
+        _clear_side(hn, ht, 1)
+    tol = SEAM_TOL * length
+    valid = -tol <= along <= length + tol and gap >= -row[C_DEPTH_LIMIT]
+    if valid and r == 0.0:
+        valid = _vertex_feature_valid(row, along, length, -nx, -ny, ca, sa)
+    if not valid:
+        return math.inf, 0.0, 0.0
+    # w: velocity of P's material point relative to E's; at fixed v the levers turn, so
+    # d/dt Ṗ = −ω_a² r_P and d/dt Ė = −ω_b² r_E, while n turns by ω_b τ and τ by −ω_b n.
+    wx, wy = vax - om_a * rpy - vbx + om_b * rey, vay + om_a * rpx - vby - om_b * rex
+    accx, accy = -om_a * om_a * rpx + om_b * om_b * rex, -om_a * om_a * rpy + om_b * om_b * rey
+    drift_n = -om_b * om_b * (gap + r) + 2.0 * om_b * (tx * wx + ty * wy) + nx * accx + ny * accy
+    drift_t = om_b * (nx * wx + ny * wy) + ny * accx - nx * accy
+    return gap, drift_n, drift_t
+
+
+@jitable
 def kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht):
     """(gap, Ḣ_N v, Ḣ_T v) of one contact; fills its 6-entry Jacobian rows hn, ht. A nan gap:
     the normal is undefined (coincident centres)."""
@@ -181,4 +274,8 @@ def kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht):
         return _disk_on_segment(row, body_a, q, v, hn, ht)
     if kind == KIND_SEGMENT_END_ON_EDGE:
         return _segment_end_on_edge(row, body_a, q, v, hn, ht)
+    if kind == KIND_VERTEX_ON_EDGE:
+        return _vertex_on_edge(row, body_a, body_b, q, v, hn, ht)
+    if kind == KIND_FIXED_VERTEX_ON_EDGE:
+        return _vertex_on_edge(row, -1, body_a, q, v, hn, ht)
     return _disk_on_disk(row, body_a, body_b, q, v, hn, ht)

@@ -26,7 +26,9 @@ from ..validation import InputError, require_finite, require_index, require_nonn
 from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_AY, C_OFF_BX, C_OFF_BY,
                               C_RADIUS_A, C_RADIUS_B, C_SEGMENT_LENGTH, C_SURFACE_VELOCITY, C_TX, C_TY,
                               C_EDGE_TX, C_EDGE_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT,
-                              KIND_SEGMENT_END_ON_EDGE, N_CONTACT_COLUMNS, kinematics_kernel)
+                              KIND_SEGMENT_END_ON_EDGE, N_CONTACT_COLUMNS, kinematics_kernel, C_CONE_1X,
+                              C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_DEPTH_LIMIT, C_TIE_WINS, KIND_VERTEX_ON_EDGE,
+                              KIND_FIXED_VERTEX_ON_EDGE)
 from .laws import ContactLaw
 
 
@@ -343,5 +345,88 @@ class DiskOnDisk(_PackedRelation):
         return KIND_DISK_ON_DISK, self.body_a, self.body_b
 
 
+def _unit(name: str, vec) -> tuple[float, float]:
+    x, y = require_point(name, vec)
+    norm = math.hypot(x, y)
+    if not 0.999999 < norm < 1.000001:
+        raise InputError(f"{name} must be a unit vector, got {quoted_point(vec)}")
+    return x / norm, y / norm
+
+
+def quoted_point(vec) -> str:
+    return "(" + ", ".join(f"{float(x):g}" for x in vec) + ")"
+
+
+@dataclass
+class VertexOnEdge(_PackedRelation):
+    """A vertex (or, with a radius, a disk) of `vertex_body` on the straight edge `edge_start` →
+    `edge_end` of `edge_body` — each a body index, or −1 for a fixed obstacle (then its points
+    are in the world frame): a box's corner on another box's top, on a table, a table's end
+    under a box. The edge belongs to a counter-clockwise outline: its outward normal is its
+    direction turned by −90°. The contact counts only while it is the touching pair of features:
+    the vertex's foot within the edge, the edge's normal in the vertex's normal `cone` (the
+    outward normals of its previous and next edges, vertex owner's frame; None for a disk) and
+    a penetration under `depth_limit`; otherwise its gap is infinite (open). At a corner exactly
+    on a corner the pair keeps the contact only if `tie_wins` (model/collision.py gives the
+    tie to one of the two mirror pairs)."""
+
+    vertex_body: int
+    vertex: tuple[float, float]
+    edge_body: int
+    edge_start: tuple[float, float]
+    edge_end: tuple[float, float]
+    cone: tuple | None = None
+    radius: float = 0.0
+    tie_wins: bool = True
+    depth_limit: float = math.inf
+    law: ContactLaw = field(default_factory=ContactLaw)
+    name: str = "vertex-edge"
+
+    def __post_init__(self):
+        self.name = _contact_name(self.name)
+        key = f"contact {self.name!r}"
+        for attr in ("vertex_body", "edge_body"):
+            value = getattr(self, attr)
+            setattr(self, attr, -1 if value == -1 else require_index(f"{key} {attr}", value))
+        if self.vertex_body == self.edge_body:
+            raise InputError(f"{key}: vertex_body and edge_body must differ, both are {self.vertex_body}")
+        for attr in ("vertex", "edge_start", "edge_end"):
+            setattr(self, attr, require_point(f"{key} {attr}", getattr(self, attr)))
+        if self.edge_start == self.edge_end:
+            raise InputError(f"{key}: edge_start and edge_end coincide (an edge of length 0)")
+        self.radius = require_nonnegative(f"{key} radius", self.radius)
+        if self.radius == 0.0:
+            if self.cone is None or len(self.cone) != 2:
+                raise InputError(f"{key} cone: a vertex needs the outward normals of its two edges")
+            self.cone = (_unit(f"{key} cone[0]", self.cone[0]), _unit(f"{key} cone[1]", self.cone[1]))
+        if not (isinstance(self.depth_limit, (int, float)) and self.depth_limit == math.inf):
+            self.depth_limit = require_nonnegative(f"{key} depth_limit", self.depth_limit)
+        _require_type(f"{key} law", self.law, ContactLaw)
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return tuple(b for b in (self.vertex_body, self.edge_body) if b >= 0)
+
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the geometry into a packed row; returns (kind, body a, body b)."""
+        if self.vertex_body >= 0:
+            _fill_disk_a(row, self.vertex, self.radius)
+        else:
+            row[C_LINE_PX], row[C_LINE_PY] = self.vertex
+        row[C_OFF_BX], row[C_OFF_BY] = self.edge_start
+        length = math.hypot(self.edge_end[0] - self.edge_start[0], self.edge_end[1] - self.edge_start[1])
+        row[C_EDGE_TX] = (self.edge_end[0] - self.edge_start[0]) / length
+        row[C_EDGE_TY] = (self.edge_end[1] - self.edge_start[1]) / length
+        row[C_SEGMENT_LENGTH] = length
+        if self.cone is not None:
+            (row[C_CONE_1X], row[C_CONE_1Y]), (row[C_CONE_2X], row[C_CONE_2Y]) = self.cone
+        row[C_TIE_WINS] = 1.0 if self.tie_wins else 0.0
+        row[C_DEPTH_LIMIT] = self.depth_limit
+        if self.vertex_body >= 0:
+            return KIND_VERTEX_ON_EDGE, self.vertex_body, self.edge_body
+        return KIND_FIXED_VERTEX_ON_EDGE, self.edge_body, -1
+
+
 # Every contact relation a scene can hold, by the names users write (for error messages).
-RELATION_NAMES = ("DiskOnLine", "PointOnLine", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "DiskOnDisk")
+RELATION_NAMES = ("DiskOnLine", "PointOnLine", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "DiskOnDisk",
+                  "VertexOnEdge")

@@ -20,7 +20,8 @@ from ..validation import InputError
 from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, C_OFF_AX, C_OFF_AY,  # noqa: F401
                               C_OFF_BX, C_OFF_BY, C_RADIUS_A, C_RADIUS_B, C_RESTITUTION, C_SEGMENT_LENGTH,
                               C_SURFACE_VELOCITY, C_TX, C_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE,
-                              KIND_DISK_ON_SEGMENT, N_CONTACT_COLUMNS, kinematics_kernel)
+                              KIND_DISK_ON_SEGMENT, N_CONTACT_COLUMNS, kinematics_kernel, C_EDGE_TX, C_EDGE_TY,
+                              KIND_FIXED_VERTEX_ON_EDGE, KIND_SEGMENT_END_ON_EDGE, KIND_VERTEX_ON_EDGE)
 from .forces import pack_forces
 
 # Int columns: kind, body a, body b (−1 for a fixed obstacle).
@@ -37,8 +38,8 @@ class PackedScene:
     force_index: np.ndarray
     force_times: np.ndarray
     force_values: np.ndarray
-    disks: np.ndarray  # (n_disks, 3): body-frame offset x, y and radius of every disk in a disk–disk contact
-    disk_body: np.ndarray  # (n_disks,) int64
+    disks: np.ndarray  # (n_disks, 3): offset x, y and radius of every feature circle (pack_disk_pairs)
+    disk_body: np.ndarray  # (n_disks,) int64; −1: a fixed circle (offset in the world frame)
     pair_keys: np.ndarray  # (n_pairs,) int64 sorted: min(disk a, disk b) · n_disks + max(...)
     pair_contact: np.ndarray  # (n_pairs,) int64: the contact of each key
 
@@ -65,19 +66,41 @@ def pack_contacts(contacts, n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
     return table, index
 
 
+def _feature_circles(kind, row, body_a, body_b):
+    """Circles (body or −1, offset x, y, radius; body frame, world when fixed) that hold each
+    side's feature of a contact, for the broad phase; None for a line (infinite: always tested).
+    An edge's circle is around its middle, through its ends."""
+    if kind == KIND_DISK_ON_DISK:
+        return ((body_a, row[C_OFF_AX], row[C_OFF_AY], row[C_RADIUS_A]),
+                (body_b, row[C_OFF_BX], row[C_OFF_BY], row[C_RADIUS_B]))
+    half = 0.5 * row[C_SEGMENT_LENGTH]
+    if kind == KIND_VERTEX_ON_EDGE:
+        return ((body_a, row[C_OFF_AX], row[C_OFF_AY], row[C_RADIUS_A]),
+                (body_b, row[C_OFF_BX] + half * row[C_EDGE_TX], row[C_OFF_BY] + half * row[C_EDGE_TY], half))
+    if kind == KIND_FIXED_VERTEX_ON_EDGE:
+        return ((-1, row[C_LINE_PX], row[C_LINE_PY], 0.0),
+                (body_a, row[C_OFF_BX] + half * row[C_EDGE_TX], row[C_OFF_BY] + half * row[C_EDGE_TY], half))
+    if kind == KIND_SEGMENT_END_ON_EDGE:
+        return ((-1, row[C_LINE_PX], row[C_LINE_PY], 0.0),
+                (body_a, row[C_OFF_AX] + half * row[C_EDGE_TX], row[C_OFF_AY] + half * row[C_EDGE_TY], half))
+    if kind == KIND_DISK_ON_SEGMENT:
+        return ((body_a, row[C_OFF_AX], row[C_OFF_AY], row[C_RADIUS_A]),
+                (-1, row[C_LINE_PX] + half * row[C_TX], row[C_LINE_PY] + half * row[C_TY], half))
+    return None
+
+
 def pack_disk_pairs(table, index):
-    """The broad phase's tables: the distinct disks of the disk–disk contacts and, sorted by
-    disk pair, which contact joins them."""
-    pairs = np.flatnonzero(index[:, CI_KIND] == KIND_DISK_ON_DISK)
-    if not pairs.size:  # most scenes: no table to build
-        no_ints = np.zeros(0, dtype=np.int64)
-        return np.zeros((0, 3)), no_ints, no_ints.copy(), no_ints.copy()
+    """The broad phase's tables: the distinct circles holding the contacts' features (a disk; a
+    vertex, radius 0; an edge or segment, around its middle — `_feature_circles`) and, sorted by
+    circle pair, which contact joins them. Contacts on lines are not in them."""
     disk_id, disks, bodies, keys, owners = {}, [], [], [], []
-    for i in pairs:
+    for i in range(index.shape[0]):
+        circles = _feature_circles(index[i, CI_KIND], table[i], index[i, CI_BODY_A], index[i, CI_BODY_B])
+        if circles is None:
+            continue
         ends = []
-        for body, columns in ((index[i, CI_BODY_A], (C_OFF_AX, C_OFF_AY, C_RADIUS_A)),
-                              (index[i, CI_BODY_B], (C_OFF_BX, C_OFF_BY, C_RADIUS_B))):
-            disk = (int(body), *(float(table[i, c]) for c in columns))
+        for circle in circles:
+            disk = (int(circle[0]), *(float(x) for x in circle[1:]))
             if disk not in disk_id:
                 disk_id[disk] = len(disks)
                 disks.append(disk[1:])

@@ -1,4 +1,4 @@
-"""Animations of any scene: bodies (disks, balls, rectangles, rods), lines, segments and contact forces.
+"""Animations of any scene: bodies (disks, balls, rectangles, polygons, rods), lines, segments and contact forces.
 
 How a body is drawn: from its `shape` in the scene file (disk/ball: a circle with a spoke to show
 the turn; rectangle; rod: a segment; rod-with-balls: a segment with a ball at each end, the centre
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
-from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge
+from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge, VertexOnEdge
 from ..validation import InputError
 
 
@@ -47,6 +47,11 @@ def _contact_parts(scene, body: int) -> list:
             parts.append((tuple(c.offset), c.radius))
         elif isinstance(c, SegmentEndOnEdge) and c.body == body:
             parts += [(tuple(c.edge_start), 0.0), (tuple(c.edge_end), 0.0)]
+        elif isinstance(c, VertexOnEdge):
+            if c.vertex_body == body:
+                parts.append((tuple(c.vertex), c.radius))
+            if c.edge_body == body:
+                parts += [(tuple(c.edge_start), 0.0), (tuple(c.edge_end), 0.0)]
         elif isinstance(c, DiskOnDisk):
             if c.body_a == body:
                 parts.append((tuple(c.offset_a), c.radius_a))
@@ -65,6 +70,8 @@ def body_outline(sf, body: int) -> list:
     if kind == "rectangle":
         a, b = shape["width"] / 2, shape["height"] / 2
         return [("polygon", [(-a, -b), (a, -b), (a, b), (-a, b)])]
+    if kind == "polygon":
+        return [("polygon", [tuple(p) for p in shape["vertices"]])]
     if kind == "rod":
         return [("segment", (-shape["length"] / 2, 0.0), (shape["length"] / 2, 0.0))]
     if kind == "rod-with-balls":
@@ -184,6 +191,12 @@ def contact_frames(scene, q: np.ndarray) -> list[tuple]:
             d = ca - cb
             n = d / max(np.linalg.norm(d), 1e-300)
             out.append((ca - c.radius_a * n, n, np.array([n[1], -n[0]])))
+        elif isinstance(c, VertexOnEdge):  # at the vertex (or the disk's touching point); force on its first body
+            j = 3 * c.bodies[0]
+            k = c.kinematics(q, np.zeros_like(q), q.size)
+            n, t = k.H_N[j: j + 2], k.H_T[j: j + 2]
+            point = _world(q, 3 * c.vertex_body, c.vertex) - c.radius * n if c.vertex_body >= 0 else np.array(c.vertex)
+            out.append((point, n, t))
         elif isinstance(c, (DiskOnSegment, SegmentEndOnEdge)):  # the touched feature's normal: from the kinematics
             j = 3 * c.body
             k = c.kinematics(q, np.zeros_like(q), q.size)
@@ -220,6 +233,21 @@ FRAME_WIDTH_IN = 6.0
 MARGINS_IN = {"left": 0.75, "right": 0.15, "bottom": 0.55, "top": 0.12}
 STATUS_FONT_PT = 8
 _CHAR_WIDTH_EM = 0.602  # DejaVu Sans Mono, matplotlib's monospace
+
+
+# A scene with more contacts than this (shapes' candidate contacts: a box pair lists 32) is
+# drawn with only the contacts that ever touch: the others are open throughout.
+ALL_CONTACTS_UP_TO = 12
+
+
+def shown_contacts(result) -> list[tuple[int, str]]:
+    """(column, name) of the contacts the figure draws."""
+    names = list(result.contact_names)
+    if len(names) <= ALL_CONTACTS_UP_TO:
+        return list(enumerate(names))
+    return [(k, name) for k, name in enumerate(names)
+            if any(str(ph.mode) != "open" for ph in result.phases.get(name, []))
+            or np.any(result.trajectory.normal_force[:, k] != 0.0)]
 
 
 class StatusText:
@@ -274,7 +302,8 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
         raise InputError("animating a run needs its scene file (result.scene_file) to know the bodies' shapes")
     tr = result.trajectory
     extent = scene_extent(result, sf)
-    status = StatusText(result.contact_names)
+    shown = shown_contacts(result)
+    status = StatusText([name for _, name in shown])
     fig, ax = _frame_figure(extent, status.lines, dpi)
     draw_lines(ax, sf, extent)
     bodies = _make_artists(ax, sf)
@@ -300,7 +329,7 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
                             for c, g in enumerate(geo)]) * scale
             arrows.set_offsets(pts)
             arrows.set_UVC(vec[:, 0], vec[:, 1])
-        label.set_text(status.text(tr.t[i], tr.modes[i]))
+        label.set_text(status.text(tr.t[i], [tr.modes[i, k] for k, _ in shown]))
         return []
 
     return animation.FuncAnimation(fig, update, frames=len(indices), interval=1000 / fps, blit=False)

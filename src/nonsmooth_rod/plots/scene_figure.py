@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
+from .animation import shown_contacts
 
 # The line plots colour bodies and contacts C0, C1, ... (blue, orange, green, red, ...): the phase
 # bar must not reuse a hue, or "stick" reads as "the first body". Its states are greys and
@@ -76,7 +77,7 @@ def _coordinates(ax, result, names) -> None:
 
 def _forces(ax, result) -> None:
     tr = result.trajectory
-    for k, name in enumerate(result.contact_names):
+    for k, name in shown_contacts(result):
         ax.plot(tr.t, tr.normal_force[:, k], label=f"{name} N")
         ax.plot(tr.t, tr.tangential_force[:, k], "--", color=ax.lines[-1].get_color(), label=f"{name} T")
     _robust_ylim(ax, np.concatenate([tr.normal_force.ravel(), tr.tangential_force.ravel()]))
@@ -88,7 +89,7 @@ def _forces(ax, result) -> None:
 def _ratios(ax, result) -> None:
     tr, mu = result.trajectory, contact_mu_s(result)
     scale = np.max(np.abs(tr.normal_force)) if tr.normal_force.size else 0.0
-    for k, name in enumerate(result.contact_names):
+    for k, name in shown_contacts(result):
         n = tr.normal_force[:, k]
         ratio = np.where(n > 1e-9 * scale, tr.tangential_force[:, k] / np.where(n > 0, n, 1.0), np.nan)
         line, = ax.plot(tr.t, ratio, label=f"{name} T/N")
@@ -110,7 +111,7 @@ def mode_style(mode) -> dict:
 def _phases(ax, result) -> None:
     from matplotlib.patches import Patch
 
-    names = result.contact_names
+    names = [name for _, name in shown_contacts(result)]
     for k, name in enumerate(names):
         for ph in result.phases.get(name, []):
             ax.broken_barh([(ph.t_start, ph.t_end - ph.t_start)], (k - 0.4, 0.8), linewidth=0.5,
@@ -135,7 +136,7 @@ def result_figure(result):
 
     names = body_names(result)
     fig = Figure(figsize=(12, 10), layout="constrained")
-    grid = fig.add_gridspec(3, 2, height_ratios=(1.2, 1, 0.5 + 0.15 * len(result.contact_names)))
+    grid = fig.add_gridspec(3, 2, height_ratios=(1.2, 1, 0.5 + 0.15 * len(shown_contacts(result))))
     panels = {"paths": grid[0, 0], "coordinates": grid[0, 1], "forces": grid[1, 0], "ratios": grid[1, 1],
               "phases": grid[2, :]}
     axes = {key: fig.add_subplot(spec, label=key) for key, spec in panels.items()}

@@ -1,0 +1,20 @@
+"""benchmarks/bench_shapes.py --quick: the tower with found contacts runs the very run of the tower
+with the touching contacts declared by hand, and holds (no speed is asserted here)."""
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_shapes.py"
+
+
+def test_bench_shapes_quick(capsys):
+    spec = importlib.util.spec_from_file_location("bench_shapes", BENCH)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--quick", "--boxes", "3"]) == 0  # 0: the two runs agree to 1e-12 m
+    out = capsys.readouterr().out
+    creeps = [float(x) for x in re.findall(r"creep ([0-9.e+-]+) m", out)]
+    assert len(creeps) == 2 and max(creeps) < 1e-10
+    assert "finding the contacts costs" in out
