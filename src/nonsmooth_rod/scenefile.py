@@ -659,6 +659,13 @@ def _dotted(path) -> str:
     return text
 
 
+def _gravity(w, data):
+    """`gravity`: a number g ≥ 0 (g downward, −y) or the vector [gx, gy]."""
+    if isinstance(data.get("gravity"), list):
+        return _vector(w, data, "gravity", "", 2)
+    return _number(w, data, "gravity", "", 9.81, nonnegative=True)
+
+
 def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     """The SceneFile of a scene's content (a dict as read from TOML or JSON)."""
     w = _Where(source)
@@ -669,7 +676,7 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
         raise w.error("schema", f"must be {SCHEMA!r} (this version reads that schema), got {quoted(schema)}")
     for key in ("title", "description"):
         _text(w, data, key, "", "")
-    gravity = _number(w, data, "gravity", "", 9.81, nonnegative=True)
+    gravity = _gravity(w, data)
     bodies, body_names, shapes = _bodies(w, data)
     lines, segments = _lines(w, data), _segments(w, data)
     contacts = _contacts(w, data, body_names, lines, segments)

@@ -28,7 +28,12 @@ KIND_DISK_ON_LINE, KIND_DISK_ON_DISK, KIND_DISK_ON_SEGMENT, KIND_SEGMENT_END_ON_
 # (body frame) in C_EDGE_T* and its length in C_SEGMENT_LENGTH.
 (C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_OFF_BX, C_OFF_BY, C_RADIUS_B, C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_TX,
  C_TY, C_SURFACE_VELOCITY, C_MU_S, C_MU_D, C_RESTITUTION, C_SEGMENT_LENGTH, C_EDGE_TX, C_EDGE_TY) = range(19)
-N_CONTACT_COLUMNS = 19
+# A driven obstacle (model/motion.py): the motion moving it (−1: none, a float holding an index),
+# the obstacle point C_LINE_P* at rest (C_LINE_P* itself is its place at the step's start) and its
+# velocity (world frame) at the step's end and at its start, which the step subtracts from the
+# contact's relative velocity at the end (the law) and at the start (activation, u_N before impact).
+C_MOTION, C_BASE_PX, C_BASE_PY, C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY = range(19, 26)
+N_CONTACT_COLUMNS = 26
 
 
 @jitable
@@ -169,6 +174,17 @@ def _segment_end_on_edge(row, body, q, v, hn, ht):
     gap = -(nx * (px - q[j] - ex) + ny * (py - q[j + 1] - ey))
     return (gap, 2.0 * om * (nx * vy - ny * vx) + om * om * (rho_x * nx + rho_y * ny),
             2.0 * om * (ny * vy + nx * vx) + om * om * (rho_x * ny - rho_y * nx))
+
+
+@jitable
+def obstacle_velocity(row, hn, ht, at_start):
+    """(w_N, w_T): the obstacle's velocity along the contact's normal and tangent (a driven
+    obstacle's at the step's end, or start, plus a belt's surface velocity along its tangent),
+    subtracted from H v to give the relative velocity. hn[0:2], ht[0:2] are n and t (body a's
+    side, sign +1)."""
+    column = C_OBSTACLE_START_VX if at_start else C_OBSTACLE_VX
+    wx, wy = row[column], row[column + 1]
+    return hn[0] * wx + hn[1] * wy, ht[0] * wx + ht[1] * wy + row[C_SURFACE_VELOCITY]
 
 
 @jitable
