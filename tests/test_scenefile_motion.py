@@ -103,3 +103,16 @@ def test_a_bad_motion_exits_2_with_one_line_and_other_methods_refuse_driven_scen
 
             sf = load_scene(SCENES / "shaken_block.toml", [f'simulation.method="{method}"'])
             simulate_scene(sf)
+
+
+def test_a_run_without_a_file_describes_its_motions_as_the_file_would():
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.result_files import scene_description
+
+    sf = parse_scene(copy.deepcopy(PLATE))
+    result = nr.simulate(sf.scene, sf.q0, sf.v0, 0.002, h=1e-3)
+    data = scene_description(result)
+    assert data["gravity"] == (1.0, -9.0)
+    assert data["lines"][0]["motion"] == {"kind": "harmonic", "amplitude": [0.0, 0.01], "frequency_hz": 8.0,
+                                          "phase_deg": pytest.approx(90.0)}
+    assert data["bodies"][1]["motion"] == PLATE["bodies"][1]["motion"] and "motion" not in data["bodies"][0]

@@ -72,5 +72,6 @@ def check_output_size(samples: float, scene, knob: str = "save_every or a shorte
     return needed
 
 
-__all__ = ["METHODS", "DRIVEN_METHODS", "check_driven", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes", "sample_bytes",
+__all__ = ["METHODS", "DRIVEN_METHODS", "check_driven", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes",
+           "sample_bytes",
            "supported_contacts"]

@@ -291,7 +291,8 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             u_n = relative_normal_velocity(table, hn, ht, index, i, vk, True)
             q_step[2 * a] = (relative_normal_velocity(table, hn, ht, index, i, v_free, False)
                              + table[i, C_RESTITUTION] * min(u_n, 0.0))
-            u_t = relative_slip_velocity(table, hn, ht, index, i, vk, True)  # a closing contact slides the way it arrives
+            # a closing contact slides the way it arrives
+            u_t = relative_slip_velocity(table, hn, ht, index, i, vk, True)
             guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
 
 

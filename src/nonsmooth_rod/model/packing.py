@@ -21,7 +21,8 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, 
                               C_OFF_BX, C_OFF_BY, C_RADIUS_A, C_RADIUS_B, C_RESTITUTION, C_SEGMENT_LENGTH,
                               C_SURFACE_VELOCITY, C_TX, C_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE,
                               KIND_DISK_ON_SEGMENT, N_CONTACT_COLUMNS, C_MOTION, C_BASE_PX, C_BASE_PY,
-                              C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, kinematics_kernel, obstacle_velocity)
+                              C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
+                              kinematics_kernel, obstacle_velocity)
 from .forces import pack_forces
 from .motion import NOW_START, NOW_START_VELOCITY, NOW_VELOCITY, pack_motions
 
