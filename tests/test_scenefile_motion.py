@@ -74,6 +74,7 @@ BAD = [
     ("bodies.shaker.motion.positions", "[[0, 0], [0, nan]]", "bodies.shaker.motion.positions[1][1]: must be finite"),
     ("bodies.shaker.motion.positions", "[[0, 0, 0, 0], [0, 0, 0, 0]]",
      "bodies.shaker.motion.positions[0]: must be a list of 2 numbers"),
+    ("lines.plate.motion.frequency_hz", "1e200", "lines.plate.motion: motion amplitude × (2π frequency_hz)² overflows"),
     ("gravity", "[0, 1, 2]", "gravity: must be a list of 2 numbers"),
     ("gravity", "[0, inf]", "gravity[1]: must be finite"),
     ("gravity", "-9.81", "gravity: must be non-negative"),

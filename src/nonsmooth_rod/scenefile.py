@@ -314,7 +314,15 @@ def _motion(w, t, key, widths):
     """The `motion` table of a line, segment (widths (2,): x, y) or body ((2, 3): x, y(, θ)), or None."""
     if "motion" not in t:
         return None
-    m, key = t["motion"], f"{key}.motion"
+    try:
+        return _motion_of(w, t["motion"], f"{key}.motion", widths)
+    except InputError as err:
+        if str(err).startswith(w.source):
+            raise
+        raise w.error(f"{key}.motion", str(err)) from None
+
+
+def _motion_of(w, m, key, widths):
     if not isinstance(m, dict):
         raise w.error(key, f"must be a table {{ kind = \"harmonic\" | \"table\", ... }}, got {quoted(m)}")
     kind = _text(w, m, "kind", key, choices=tuple(MOTION_KEYS))

@@ -60,6 +60,7 @@ def test_driven_bodies_have_infinite_mass_in_the_packed_scene():
     (lambda: Harmonic((0.0, math.nan), 1.0), "motion amplitude[1] must be finite"),
     (lambda: Harmonic((0.0,), 1.0), "motion amplitude must have 2 or 3 numbers"),
     (lambda: Harmonic((0.0, 1.0), -1.0), "motion frequency_hz must be non-negative"),
+    (lambda: Harmonic((0.0, 1e300), 1e10), "the motion's acceleration is not finite"),
     (lambda: Line(motion=Harmonic((0.0, 1.0, 0.5), 1.0)), "line motion: a line or segment translates"),
     (lambda: Segment((0, 0), (1, 0), motion="shake"), "segment 'segment' motion must be a Harmonic"),
     (lambda: Prescribed(3.0), "needs a callable"),

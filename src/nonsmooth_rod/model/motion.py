@@ -55,6 +55,10 @@ class Harmonic:
         object.__setattr__(self, "amplitude", _components("motion amplitude", self.amplitude, (2, 3)))
         require_nonnegative("motion frequency_hz", self.frequency_hz)
         require_finite("motion phase", self.phase)
+        omega = 2.0 * math.pi * self.frequency_hz
+        if not all(math.isfinite(a * omega * omega) for a in self.amplitude) or not math.isfinite(omega * omega):
+            raise InputError(f"motion amplitude × (2π frequency_hz)² overflows: {quoted(self.amplitude)} at "
+                             f"{self.frequency_hz:g} Hz (the motion's acceleration is not finite)")
 
     @property
     def n_components(self) -> int:
