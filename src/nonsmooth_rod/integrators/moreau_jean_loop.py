@@ -34,11 +34,11 @@ def _inlined(function):
     import numba
 
     return numba.njit(cache=True, inline="always")(function)
+from ..model.contact_kernels import C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_SURFACE_VELOCITY, obstacle_velocity
 from ..model.forces import accumulate_forces
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND, KIND_DISK_ON_DISK,
-                             contact_kinematics, drive_contacts, local_dot, relative_normal_velocity,
-                             relative_slip_velocity)
+                             contact_kinematics, drive_contacts, local_dot)
 from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
                                        two_coefficient_by_group, two_coefficient_kernel)
@@ -76,6 +76,27 @@ I_SOLVER, I_MAX_ITER, I_STOP = range(3)
 # motions (table, times, values), their evaluation at the current step (NOW_* columns), the driven
 # bodies (body, motion) and each one's placement the motion displaces (origin: q0 − d(t0)).
 M_MOTIONS, M_MOTION_TIMES, M_MOTION_VALUES, M_MOTION_NOW, M_DRIVEN, M_DRIVEN_ORIGIN = range(12, 18)
+
+
+@_inlined
+def _obstacle_velocity(table, hn, ht, i, at_start):
+    """(w_N, w_T) of contact i's obstacle: its velocity at the step's start (for the start velocity
+    v_k) or end (for v_{k+1}), along n and t, plus a belt's surface velocity."""
+    c = C_OBSTACLE_START_VX if at_start else C_OBSTACLE_VX
+    return obstacle_velocity(hn[i, 0], hn[i, 1], ht[i, 0], ht[i, 1], table[i, c], table[i, c + 1],
+                             table[i, C_SURFACE_VELOCITY])
+
+
+@_inlined
+def relative_normal_velocity(table, hn, ht, index, i, x, at_start):
+    """u_N of contact i at the scene velocity x: H_N x less the obstacle's normal velocity."""
+    return local_dot(hn[i], index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[0]
+
+
+@_inlined
+def relative_slip_velocity(table, hn, ht, index, i, x, at_start):
+    """u_T of contact i at the scene velocity x: H_T x less the obstacle's (and a belt's) tangential velocity."""
+    return local_dot(ht[i], index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[1]
 
 
 @jit

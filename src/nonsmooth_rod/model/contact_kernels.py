@@ -177,14 +177,11 @@ def _segment_end_on_edge(row, body, q, v, hn, ht):
 
 
 @jitable
-def obstacle_velocity(row, hn, ht, at_start):
-    """(w_N, w_T): the obstacle's velocity along the contact's normal and tangent (a driven
-    obstacle's at the step's end, or start, plus a belt's surface velocity along its tangent),
-    subtracted from H v to give the relative velocity. hn[0:2], ht[0:2] are n and t (body a's
-    side, sign +1)."""
-    column = C_OBSTACLE_START_VX if at_start else C_OBSTACLE_VX
-    wx, wy = row[column], row[column + 1]
-    return hn[0] * wx + hn[1] * wy, ht[0] * wx + ht[1] * wy + row[C_SURFACE_VELOCITY]
+def obstacle_velocity(nx, ny, tx, ty, wx, wy, surface):
+    """(w_N, w_T): an obstacle's velocity w (a driven obstacle's) along the contact's normal n and
+    tangent t, plus a belt's surface velocity along t — what the relative velocity subtracts from
+    H v. Scalars: the compiled loop reads them from its tables without making array views."""
+    return nx * wx + ny * wy, tx * wx + ty * wy + surface
 
 
 @jitable

@@ -180,7 +180,8 @@ class _PackedRelation:
         for side, body in enumerate((body_a, body_b)):
             for d in range(3 if body >= 0 else 0):  # element by element: cheaper than a slice
                 H_N[3 * body + d], H_T[3 * body + d] = hn[3 * side + d], ht[3 * side + d]
-        w_n, w_t = obstacle_velocity(row, hn, ht, False)
+        w_n, w_t = obstacle_velocity(hn[0], hn[1], ht[0], ht[1], row[C_OBSTACLE_VX], row[C_OBSTACLE_VY],
+                                     row[C_SURFACE_VELOCITY])  # n, t: hn[0:2], ht[0:2] (body a's side)
         return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, w_t, w_n)
 
 

@@ -22,7 +22,7 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, 
                               C_SURFACE_VELOCITY, C_TX, C_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE,
                               KIND_DISK_ON_SEGMENT, N_CONTACT_COLUMNS, C_MOTION, C_BASE_PX, C_BASE_PY,
                               C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
-                              kinematics_kernel, obstacle_velocity)
+                              kinematics_kernel)
 from .forces import pack_forces
 from .motion import NOW_START, NOW_START_VELOCITY, NOW_VELOCITY, pack_motions
 
@@ -154,19 +154,6 @@ def drive_contacts(table, now):
             table[i, C_OBSTACLE_VY] = now[m, NOW_VELOCITY + 1]
             table[i, C_OBSTACLE_START_VX] = now[m, NOW_START_VELOCITY]
             table[i, C_OBSTACLE_START_VY] = now[m, NOW_START_VELOCITY + 1]
-
-
-@jit
-def relative_normal_velocity(table, hn, ht, index, i, x, at_start):
-    """u_N of contact i at the scene velocity x: H_N x less the obstacle's normal velocity (at the
-    step's start for the start velocity v_k, else at its end)."""
-    return local_dot(hn[i], index, i, x) - obstacle_velocity(table[i], hn[i], ht[i], at_start)[0]
-
-
-@jit
-def relative_slip_velocity(table, hn, ht, index, i, x, at_start):
-    """u_T of contact i at the scene velocity x: H_T x less the obstacle's (and belt's) tangential velocity."""
-    return local_dot(ht[i], index, i, x) - obstacle_velocity(table[i], hn[i], ht[i], at_start)[1]
 
 
 @jit
