@@ -474,12 +474,15 @@ def _step(solver_code, k, f, params, iparams, model, work, out):
     code at run time: run_steps and compiled_step serve every solver)."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
-    drive_step(k, params, model)
+    driven = model[M_DRIVEN].shape[0] > 0  # (a scene without driven bodies skips their calls: measurably faster)
+    if model[M_MOTIONS].shape[0] > 0:
+        drive_step(k, params, model)
     na = begin_step(params, qk, vk, f, model, work)
     if na < 0:
         counters[K_FAIL_CONTACT] = -1 - na
         return RUN_BAD_GEOMETRY
-    hold_driven_velocities(model, work)
+    if driven:
+        hold_driven_velocities(model, work)
     p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
     if na > 0:
         status, p, u, states = solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out)
@@ -487,7 +490,8 @@ def _step(solver_code, k, f, params, iparams, model, work, out):
             counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
     status = finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out)
-    place_driven_bodies(k, model, out)
+    if driven:
+        place_driven_bodies(k, model, out)
     return status
 
 
@@ -495,11 +499,9 @@ def _step(solver_code, k, f, params, iparams, model, work, out):
 def drive_step(k, params, model):
     """Step k's driven obstacles and bodies: the motions at its start and end (the compiled ones;
     the step-wise loop wrote the Python ones), the driven obstacles' contact rows moved there."""
-    motions = model[M_MOTIONS]
-    if motions.shape[0] == 0:
-        return
     t = step_time(params, k)
-    evaluate_motions(t, t + params[P_H], motions, model[M_MOTION_TIMES], model[M_MOTION_VALUES], model[M_MOTION_NOW])
+    evaluate_motions(t, t + params[P_H], model[M_MOTIONS], model[M_MOTION_TIMES], model[M_MOTION_VALUES],
+                     model[M_MOTION_NOW])
     drive_contacts(model[2], model[M_MOTION_NOW])
 
 
