@@ -18,6 +18,7 @@ from .model.contacts import (DiskOnDisk, DiskOnLine, DiskOnSegment, Line, PointO
 from .model.collision import Disk, PairLaws, Polygon, Polyline, find_contacts
 from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce
 from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
+from .model.motion import DrivenBody, Harmonic, Prescribed, Tabulated
 from .model.scene import Scene
 from .results import ContactState, Event, Impact, Phase, SimulationResult, Status, Trajectory
 from .solvers import ContactSolution, PlanarFrictionProblem, SolverError, solve
@@ -51,4 +52,5 @@ __all__ = [
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
     "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",
     "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "sweep", "fit",
+    "Harmonic", "Tabulated", "Prescribed", "DrivenBody",
 ]

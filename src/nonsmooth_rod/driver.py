@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _jit
-from .integrators import METHODS, MAX_OUTPUT_BYTES, check_output_size, integrator_classes, supported_contacts
+from .integrators import (METHODS, MAX_OUTPUT_BYTES, check_driven, check_output_size, integrator_classes,
+                          supported_contacts)
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
 from .validation import InputError, quoted, require_finite, require_positive, require_state
@@ -115,6 +116,7 @@ def _method(method, scene: Scene):
         if type(contact).__name__ not in handled:
             raise InputError(f"method {method!r} does not handle {type(contact).__name__} contacts "
                              f"(contact {contact.name!r}); it handles {', '.join(handled)}")
+    check_driven(method, scene)
     return integrator_classes(method)
 
 

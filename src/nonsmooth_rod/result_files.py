@@ -142,6 +142,21 @@ def _segment_contact_data(contact, bodies, segments, law) -> dict:
     return data | ({"radius": contact.radius} if contact.radius > 0 else {})
 
 
+def _motion_data(motion) -> dict:
+    """{"motion": ...} of a driven line, segment or body, in the scene file's layout ({} for none)."""
+    from .model.motion import Harmonic, Tabulated
+
+    if motion is None:
+        return {}
+    if isinstance(motion, Harmonic):
+        return {"motion": {"kind": "harmonic", "amplitude": list(motion.amplitude),
+                           "frequency_hz": motion.frequency_hz, "phase_deg": math.degrees(motion.phase)}}
+    if isinstance(motion, Tabulated):
+        return {"motion": {"kind": "table", "times": list(motion.times),
+                           "positions": [list(p) for p in motion.positions]}}
+    return {"motion": {"kind": "python", "function": _plain(motion.function)}}
+
+
 def _force_data(force, bodies) -> dict:
     import dataclasses
 
@@ -163,13 +178,15 @@ def scene_description(result) -> dict | None:
     segments: dict = {}
     contacts = [_contact_data(c, bodies, lines, segments) for c in scene.contacts]
     q0, v0 = np.asarray(inputs["q0"], float), np.asarray(inputs["v0"], float)
+    driven = {d.body: d.motion for d in getattr(scene, "driven", ())}
     return {
         "gravity": scene.gravity,
-        "bodies": [{"name": n, "mass": b.mass, "inertia": b.inertia} for n, b in zip(bodies, scene.bodies)],
+        "bodies": [{"name": n, "mass": b.mass, "inertia": b.inertia} | _motion_data(driven.get(i))
+                   for i, (n, b) in enumerate(zip(bodies, scene.bodies))],
         "lines": [{"name": n, "point": list(line.point), "angle_deg": math.degrees(line.angle),
-                   "velocity": line.velocity} for n, line in lines.items()],
-        **({"segments": [{"name": n, "a": list(s.a), "b": list(s.b)} for n, s in segments.items()]}
-           if segments else {}),
+                   "velocity": line.velocity} | _motion_data(line.motion) for n, line in lines.items()],
+        **({"segments": [{"name": n, "a": list(s.a), "b": list(s.b)} | _motion_data(s.motion)
+                         for n, s in segments.items()]} if segments else {}),
         "contacts": contacts, "forces": [_force_data(f, bodies) for f in scene.forces],
         "applied_force": _plain(scene.applied_force),
         "initial": {n: {"q": q0[3 * i:3 * i + 3].tolist(), "v": v0[3 * i:3 * i + 3].tolist()}

@@ -16,6 +16,6 @@ def build_force(kind: str, **fields):
     return FORCE_CLASSES[kind](**fields)
 
 
-def make_scene(bodies, contacts, gravity: float, forces=()) -> Scene:
-    """A Scene with its applied forces as data."""
-    return Scene(bodies, contacts, gravity=gravity, forces=list(forces))
+def make_scene(bodies, contacts, gravity, forces=(), driven=()) -> Scene:
+    """A Scene with its applied forces as data (and its driven bodies, model/motion.py)."""
+    return Scene(bodies, contacts, gravity=gravity, forces=list(forces), driven=list(driven))

@@ -25,6 +25,7 @@ from .model import shapes
 from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
 from .model.laws import ContactLaw
+from .model.motion import DrivenBody, Harmonic, Tabulated
 from .scene_forces import FORCE_KINDS, build_force, make_scene
 from .validation import MAX_INTEGER, MAX_STATE, InputError, quoted, require_finite
 
@@ -47,8 +48,10 @@ TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "seg
 BODY_KEYS = ("name", "mass", "inertia", "shape", "density", "thickness", "radius", "width", "height",
              "length", "ball_radius", "rod_diameter", "vertices", "collide", "group")
 COLLISION_KEYS = ("collide", "group")  # scene_collisions.py: not dimensions of a shape
-LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length")
-SEGMENT_KEYS = ("name", "a", "b")
+LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length", "motion")
+SEGMENT_KEYS = ("name", "a", "b", "motion")
+# A prescribed motion (model/motion.py) of a line, segment or body: a displacement from its placement.
+MOTION_KEYS = {"harmonic": ("kind", "amplitude", "frequency_hz", "phase_deg"), "table": ("kind", "times", "positions")}
 LAW_KEYS = ("mu_s", "mu_d", "restitution")
 CONTACT_KEYS = {
     "disk-on-line": ("kind", "name", "body", "offset", "radius", "line", "law"),
@@ -281,7 +284,7 @@ def _bodies(w, data) -> tuple[list, list, dict]:
     bodies, names, shapes = [], [], {}
     for name, t in _items(w, data, "bodies"):
         key = f"bodies.{name}"
-        _check_keys(w, t, BODY_KEYS, key)
+        _check_keys(w, t, BODY_KEYS + ("motion",), key)
         shape, mass, inertia = _finite_shape_of(w, t, key)
         if "mass" in t or mass is None:
             mass = _number(w, t, "mass", key, positive=True)
@@ -310,7 +313,7 @@ def _lines(w, data) -> dict:
         _number(w, t, "length", key, None, positive=True)
         lines[name] = Line(_vector(w, t, "point", key, 2, [0.0, 0.0]),
                            math.radians(_number(w, t, "angle_deg", key, 0.0)),
-                           _number(w, t, "velocity", key, 0.0))
+                           _number(w, t, "velocity", key, 0.0), _motion(w, t, key, (2,)))
     return lines
 
 
@@ -322,8 +325,50 @@ def _segments(w, data) -> dict:
         a, b = _vector(w, t, "a", key, 2), _vector(w, t, "b", key, 2)
         if a == b:
             raise w.error(f"{key}.b", f"equals a = {list(a)}: a segment of length 0")
-        segments[name] = Segment(a, b, name)
+        segments[name] = Segment(a, b, name, _motion(w, t, key, (2,)))
     return segments
+
+
+def _motion(w, t, key, widths):
+    """The `motion` table of a line, segment (widths (2,): x, y) or body ((2, 3): x, y(, θ)), or None."""
+    if "motion" not in t:
+        return None
+    try:
+        return _motion_of(w, t["motion"], f"{key}.motion", widths)
+    except InputError as err:
+        if str(err).startswith(w.source):
+            raise
+        raise w.error(f"{key}.motion", str(err)) from None
+
+
+def _motion_of(w, m, key, widths):
+    if not isinstance(m, dict):
+        raise w.error(key, f"must be a table {{ kind = \"harmonic\" | \"table\", ... }}, got {quoted(m)}")
+    kind = _text(w, m, "kind", key, choices=tuple(MOTION_KEYS))
+    _check_keys(w, m, MOTION_KEYS[kind], key)
+    if kind == "harmonic":
+        amplitude = m.get("amplitude")
+        n = len(amplitude) if isinstance(amplitude, list) and len(amplitude) in widths else widths[0]
+        return Harmonic(_vector(w, m, "amplitude", key, n), _number(w, m, "frequency_hz", key, nonnegative=True),
+                        math.radians(_number(w, m, "phase_deg", key, 0.0)))
+    times = m.get("times")
+    if not isinstance(times, list) or not times:
+        raise w.error(f"{key}.times", f"must be a non-empty list of times, got {quoted(times)}")
+    times = _vector(w, m, "times", key, len(times))
+    if any(b <= a for a, b in itertools.pairwise(times)):
+        raise w.error(f"{key}.times", "must increase strictly")
+    rows = m.get("positions")
+    if not isinstance(rows, list) or len(rows) != len(times):
+        raise w.error(f"{key}.positions", f"must be a list of {len(times)} positions, one per time")
+    n = len(rows[0]) if isinstance(rows[0], list) and len(rows[0]) in widths else widths[0]
+    positions = [_vector(w, {f"[{i}]": r}, f"[{i}]", f"{key}.positions", n) for i, r in enumerate(rows)]
+    return Tabulated(times, positions)
+
+
+def _driven_bodies(w, data, body_names) -> list:
+    """A DrivenBody for every body with a `motion` table."""
+    return [DrivenBody(i, _motion(w, t, f"bodies.{name}", (2, 3)))
+            for i, (name, t) in enumerate(_items(w, data, "bodies")) if "motion" in t]
 
 
 def _segment_contact(w, t, key, name, kind, body_names, segments):
@@ -680,6 +725,13 @@ def _dotted(path) -> str:
     return text
 
 
+def _gravity(w, data):
+    """`gravity`: a number g ≥ 0 (g downward, −y) or the vector [gx, gy]."""
+    if isinstance(data.get("gravity"), list):
+        return _vector(w, data, "gravity", "", 2)
+    return _number(w, data, "gravity", "", 9.81, nonnegative=True)
+
+
 def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     """The SceneFile of a scene's content (a dict as read from TOML or JSON)."""
     w = _Where(source)
@@ -690,15 +742,16 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
         raise w.error("schema", f"must be {SCHEMA!r} (this version reads that schema), got {quoted(schema)}")
     for key in ("title", "description"):
         _text(w, data, key, "", "")
-    gravity = _number(w, data, "gravity", "", 9.81, nonnegative=True)
+    gravity = _gravity(w, data)
     bodies, body_names, shapes = _bodies(w, data)
     lines, segments = _lines(w, data), _segments(w, data)
     contacts = _contacts(w, data, body_names, lines, segments)
     contacts += scene_collisions.found_contacts(w, data, bodies, shapes, lines, segments, contacts)
     forces = _forces(w, data, body_names)
+    driven = _driven_bodies(w, data, body_names)
     try:
         with np.errstate(all="ignore"):
-            scene = make_scene(bodies, contacts, gravity, forces)
+            scene = make_scene(bodies, contacts, gravity, forces, driven)
     except InputError as err:
         raise w.error("", str(err)) from None
     if not np.all(np.isfinite(scene.weight)):

@@ -27,6 +27,21 @@ METHODS = {
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
 }
 
+# The methods that run driven obstacles and bodies (model/motion.py). The event-driven reference
+# would need each driven contact's gap, velocity and acceleration as functions of time in its
+# modes' ODEs and event functions, the regularized method the obstacle's velocity in its penalty
+# and friction laws: neither has them yet, and refuses such a scene by name.
+DRIVEN_METHODS = ("moreau-jean",)
+
+
+def check_driven(method: str, scene) -> None:
+    """Refuse, in one line, a driven obstacle or body for a method that does not move them."""
+    driven = scene.driven_things()
+    if driven and method not in DRIVEN_METHODS:
+        raise InputError(f"method {method!r} does not handle driven obstacles or bodies ({driven[0]} moves by a "
+                         f"prescribed motion): it lacks their time-dependent gap and velocity; use "
+                         f"{', '.join(DRIVEN_METHODS)}")
+
 
 def supported_contacts(method: str) -> tuple[str, ...]:
     """Names of the contact relation classes a method handles."""
@@ -57,5 +72,6 @@ def check_output_size(samples: float, scene, knob: str = "save_every or a shorte
     return needed
 
 
-__all__ = ["METHODS", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes", "sample_bytes",
+__all__ = ["METHODS", "DRIVEN_METHODS", "check_driven", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes",
+           "sample_bytes",
            "supported_contacts"]

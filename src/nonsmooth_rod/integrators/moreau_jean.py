@@ -25,6 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
+from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
@@ -86,7 +87,8 @@ class MoreauJeanOptions:
             self.min_phase = 2 * (self.h if self.tol is None else self.tol)
 
 
-_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step")
+_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step",
+                 "drive_step", "hold_driven_velocities", "place_driven_bodies", "step_time")
 
 
 def loop_kernels(compiled: bool):
@@ -97,12 +99,12 @@ def loop_kernels(compiled: bool):
     return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
 
 
-def _model_and_work(packed, resume: ResumeState | None):
+def _model_and_work(packed, resume: ResumeState | None, driven_origin=None):
     """The model and work tuples of moreau_jean_loop; the contact memory from `resume`."""
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
     model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
              packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
-             packed.pair_keys, packed.pair_contact)
+             packed.pair_keys, packed.pair_contact) + _drive_slots(packed, driven_origin)
     work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
             np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
             np.zeros(n_dof), np.zeros(nc, dtype=np.int64))
@@ -110,6 +112,25 @@ def _model_and_work(packed, resume: ResumeState | None):
         work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
             resume.was_closed, resume.grazing, resume.slip_sign
     return model, work
+
+
+def _drive_slots(packed, driven_origin):
+    """The model's slots M_MOTIONS … M_DRIVEN_ORIGIN (moreau_jean_loop): the packed motions, their
+    per-step evaluation and the driven bodies with the placement each motion displaces."""
+    origin = np.zeros((len(packed.driven), 3)) if driven_origin is None else driven_origin
+    return (packed.motion_table, packed.motion_times, packed.motion_values,
+            np.zeros((packed.motion_table.shape[0], N_NOW_COLUMNS)), packed.driven, origin)
+
+
+def driven_start(packed, q0, v0, t0: float):
+    """(origin of each driven body's motion, v0 with the driven bodies' prescribed velocities):
+    a driven body starts where q0 puts it and follows q0 + d(t) − d(t0)."""
+    origin, v0 = np.zeros((len(packed.driven), 3)), np.array(v0, dtype=float)
+    for r, (body, m) in enumerate(packed.driven):
+        d, w = packed.motions[m].at(t0)
+        origin[r] = q0[3 * body: 3 * body + 3] - d
+        v0[3 * body: 3 * body + 3] = w
+    return origin, v0
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -141,6 +162,11 @@ def compiled_part(solver: str, solver_code, callback: bool):
     if callback:
         return "moreau-jean-step", "the step-wise Moreau–Jean loop (Python force callback)", ["--step"]
     return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []
+
+
+def _calls_back(scene) -> bool:
+    """True when a step needs Python: a Python applied_force or a Python (Prescribed) motion."""
+    return scene.applied_force is not None or scene.python_motions()
 
 
 class Engine:
@@ -218,22 +244,23 @@ class MoreauJean:
             return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop, names)
         grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
-        model, work = _model_and_work(packed, resume)
+        origin, v0 = driven_start(packed, q0, v0, float(grid.time(grid.first)))
+        model, work = _model_and_work(packed, resume, origin)
         window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume)
         params, iparams = self._parameters(scene, grid, names)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         engine = Engine(bool(opts.fast and _jit.ENABLED),
-                        *compiled_part(opts.solver, solver_code, scene.applied_force is not None))
-        self._solver_error = None
+                        *compiled_part(opts.solver, solver_code, _calls_back(scene)))
+        self._solver_error, self._packed = None, packed
         wall = time.process_time()
         with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
             ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop))
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": engine.compiled and solver_code is not None,
-                 "force_callback": scene.applied_force is not None}
+                 "force_callback": _calls_back(scene)}
         return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
@@ -314,7 +341,7 @@ class MoreauJean:
         counters[loop.K_DONE] = r0
         kernels = engine.kernels
         with engine.compiling():
-            if scene.applied_force is None and iparams[loop.I_SOLVER] >= 0:
+            if not _calls_back(scene) and iparams[loop.I_SOLVER] >= 0:
                 status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out)
             else:
                 status = self._run_stepwise(kernels, scene, r0, r0 + n, params, iparams, model, work, out)
@@ -340,8 +367,12 @@ class MoreauJean:
         f = np.empty(scene.n_dof)
         solver_code = int(iparams[loop.I_SOLVER])
         compiled_step = kernels.compiled_step if solver_code >= 0 else None
+        motions = self._packed.motions if scene.python_motions() else ()
         for k in range(r_start, r_end):
             kernels.step_force(k, params, model, out, f)
+            if motions:
+                t = kernels.step_time(params, k)
+                evaluate_python_motions(motions, t, t + params[loop.P_H], model[loop.M_MOTION_NOW])
             if scene.applied_force is not None:
                 t = params[loop.P_T0] + ((params[loop.P_K0] + k) + params[loop.P_THETA]) * params[loop.P_H]
                 f += scene.applied(t, q[k], v[k])
@@ -357,10 +388,12 @@ class MoreauJean:
         """One step with a Python solver (QP backends): the loop's kernels around
         solve_two_coefficient."""
         q, v, counters = out[0], out[1], out[9]
+        kernels.drive_step(k, params, model)
         na = kernels.begin_step(params, q[k], v[k], f, model, work)
         if na < 0:
             counters[loop.K_FAIL_CONTACT] = -1 - na
             return loop.RUN_BAD_GEOMETRY
+        kernels.hold_driven_velocities(model, work)
         p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
         if na > 0:
             W, q_step = np.zeros((2 * na, 2 * na)), np.empty(2 * na)
@@ -377,7 +410,9 @@ class MoreauJean:
             counters[loop.K_INCONSISTENT] += not res.consistent
             p, u = res.p, res.u
             states = np.array([STATE_CODES[s] for s in res.states], dtype=np.int64)
-        return kernels.finish_step(k, params, iparams, na, p, u, states, q[k], v[k], model, work, out)
+        status = kernels.finish_step(k, params, iparams, na, p, u, states, q[k], v[k], model, work, out)
+        kernels.place_driven_bodies(k, model, out)
+        return status
 
     def _ending(self, status, k_end, grid, window, names):
         """(status word, message, solver-failure event or None) of how the run ended at step k_end."""
@@ -540,7 +575,7 @@ def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_st
                     qv = records.qv(j)
                     if qv is None:
                         return math.nan
-                    kin = contact.kinematics(qv[0], qv[1], scene.n_dof)
+                    kin = contact.kinematics(qv[0], qv[1], scene.n_dof, float(grid.time(j)))
                     return float(kin.H_T @ qv[1]) - kin.surface_velocity
 
                 offset = _boundary_offset(before.mode, after.mode, k, i, records, packed.contacts[i, C_MU_S], h,

@@ -36,9 +36,11 @@ def _inlined(function):
     import numba
 
     return numba.njit(cache=True, inline="always")(function)
+from ..model.contact_kernels import C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_SURFACE_VELOCITY, obstacle_velocity
 from ..model.forces import accumulate_forces
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A,
-                             contact_kinematics, local_dot)
+from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A,
+                             contact_kinematics, drive_contacts, local_dot)
 from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
                                        two_coefficient_by_group, two_coefficient_into)
@@ -86,6 +88,31 @@ N_IPARAMS = 4
 S_FLOATS, S_STATES, S_W, S_SOLVER_FLOATS, S_SOLVER_INTS, S_SPARSE_INTS, S_SPARSE_FLOATS = range(7)
 SCRATCH_W_CONTACTS = 64
 SCRATCH_SOLVER_CONTACTS = 16
+# Slots of the `model` tuple appended for driven obstacles and bodies (model/motion.py): the packed
+# motions (table, times, values), their evaluation at the current step (NOW_* columns), the driven
+# bodies (body, motion) and each one's placement the motion displaces (origin: q0 − d(t0)).
+M_MOTIONS, M_MOTION_TIMES, M_MOTION_VALUES, M_MOTION_NOW, M_DRIVEN, M_DRIVEN_ORIGIN = range(12, 18)
+
+
+@_inlined
+def _obstacle_velocity(table, hn, ht, i, at_start):
+    """(w_N, w_T) of contact i's obstacle: its velocity at the step's start (for the start velocity
+    v_k) or end (for v_{k+1}), along n and t, plus a belt's surface velocity."""
+    c = C_OBSTACLE_START_VX if at_start else C_OBSTACLE_VX
+    return obstacle_velocity(hn[i, 0], hn[i, 1], ht[i, 0], ht[i, 1], table[i, c], table[i, c + 1],
+                             table[i, C_SURFACE_VELOCITY])
+
+
+@_inlined
+def relative_normal_velocity(table, hn, ht, index, i, x, at_start):
+    """u_N of contact i at the scene velocity x: H_N x less the obstacle's normal velocity."""
+    return local_dot(hn[i], index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[0]
+
+
+@_inlined
+def relative_slip_velocity(table, hn, ht, index, i, x, at_start):
+    """u_T of contact i at the scene velocity x: H_T x less the obstacle's (and a belt's) tangential velocity."""
+    return local_dot(ht[i], index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[1]
 
 
 @jit
@@ -177,7 +204,7 @@ def begin_step(params, qk, vk, f, model, work):
         if math.isnan(gap):
             return -1 - i
         gaps[i], drifts[i] = gap, drift
-        predicted = gap + gamma * h * local_dot(hn[i], index, i, vk)
+        predicted = gap + gamma * h * relative_normal_velocity(table, hn, ht, index, i, vk, True)
         margin = ACTIVATION_ROUNDOFF
         if was_closed[i]:
             # the grid's h, not a shortened last step's: a contact resting at the gap the full steps
@@ -317,13 +344,13 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             j = active[b]
             _fill_block(block, 0, hn, ht, index, i, j, minv)
             W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2] = block[0]
-        surface = table[i, C_SURFACE_VELOCITY]
-        q_step[2 * a + 1] = local_dot(ht[i], index, i, v_free) - surface
+        q_step[2 * a + 1] = relative_slip_velocity(table, hn, ht, index, i, v_free, False)
         # only a contact at rest — loaded in the previous step, or not slipping at the step's start —
         # is held by a search over admissible splits (sticking.py); one grazing a rolling
         # neighbour without load keeps the solver's answer (the search costs milliseconds there)
         loaded = was_closed[i] and not grazing[i]
-        resting[a] = 1.0 if loaded or abs(local_dot(ht[i], index, i, vk) - surface) <= rest_tol else 0.0
+        at_rest = abs(relative_slip_velocity(table, hn, ht, index, i, vk, True)) <= rest_tol
+        resting[a] = 1.0 if loaded or at_rest else 0.0
         mu_s[a], mu_d[a] = table[i, C_MU_S], table[i, C_MU_D]
         if was_closed[i]:
             # A persistent contact may close an open gap, not only keep u_N ≥ 0: the Jacobian
@@ -331,13 +358,15 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             # creep open by O(h) per unit time. u_N ≥ −g/h for g > 0 removes the creep; a
             # penetration (g < 0) is not pushed out, which would inject energy after impacts.
             closing[a] = (gaps[i] if gaps[i] > gap_roundoff else 0.0) / h  # the part asking to close a gap
-            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + closing[a]
+            q_step[2 * a] = relative_normal_velocity(table, hn, ht, index, i, v_free, False) + closing[a]
             guess[a] = slip_sign[i]
         else:
             closing[a] = 0.0
-            u_n = local_dot(hn[i], index, i, vk)
-            q_step[2 * a] = local_dot(hn[i], index, i, v_free) + table[i, C_RESTITUTION] * min(u_n, 0.0)
-            u_t = local_dot(ht[i], index, i, vk) - surface  # a closing contact slides the way it arrives
+            u_n = relative_normal_velocity(table, hn, ht, index, i, vk, True)
+            q_step[2 * a] = (relative_normal_velocity(table, hn, ht, index, i, v_free, False)
+                             + table[i, C_RESTITUTION] * min(u_n, 0.0))
+            # a closing contact slides the way it arrives
+            u_t = relative_slip_velocity(table, hn, ht, index, i, vk, True)
             guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
 
 
@@ -409,15 +438,16 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
         p_normal[k, i] = 0.0
         p_tangent[k, i] = 0.0
         state_rec[k, i] = 0
-        slip[k, i] = -table[i, C_SURFACE_VELOCITY]
-        if not broad or candidate[i]:  # a contact out of reach has zero rows: no product to form
-            slip[k, i] += local_dot(ht[i], index, i, v_next)
+        if not broad or candidate[i]:
+            slip[k, i] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
+        else:  # a contact out of reach has zero rows: only the belt's surface velocity is left
+            slip[k, i] = -table[i, C_SURFACE_VELOCITY]
     for i in range(table.shape[0]):
         grazing[i] = 0
     for a in range(na):
         i = active[a]
         p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]
-        if states[a] == STATE_OPEN and was_closed[i] and _rides_the_gap(i, params, work, index, v_next):
+        if states[a] == STATE_OPEN and was_closed[i] and _rides_the_gap(i, params, work, table, index, v_next):
             grazing[i] = 1  # no force this step (reported open), yet not apart: no impact on return
         slip_sign[i] = 1.0 if state_rec[k, i] == STATE_SLIP_PLUS else (-1.0 if state_rec[k, i] == STATE_SLIP_MINUS
                                                                         else 0.0)
@@ -427,7 +457,7 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
             # An impact: a contact that was apart closes with approaching velocity. A persistent
             # contact that rode its gap without impulse for a step stays closed (grazing), so it
             # is not one.
-            u_before = local_dot(hn[i], index, i, vk)
+            u_before = relative_normal_velocity(table, hn, ht, index, i, vk, True)
             if u_before < -IMPACT_VELOCITY_TOL and _record_impact(k, t, i, u_before, work, model, out, params,
                                                                   iparams):
                 status = RUN_STOPPED
@@ -438,16 +468,16 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
 
 
 @jit
-def _rides_the_gap(i, params, work, index, v_next):
+def _rides_the_gap(i, params, work, table, index, v_next):
     """A persistent contact that got no impulse but ends the step within h² |g̈| of
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
     step is no impact — near a lift-off the normal force fades and such steps alternate with
     loaded ones."""
-    gaps, drifts, hn, a_free = work[0], work[1], work[2], work[9]
+    gaps, drifts, hn, ht, a_free = work[0], work[1], work[2], work[3], work[9]
     h = params[P_H]
     # within one step's worth of its acceleration, h² |g̈|: a hop of a ball at rest is longer
     margin = h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
-    return gaps[i] + h * local_dot(hn[i], index, i, v_next) <= margin
+    return gaps[i] + h * relative_normal_velocity(table, hn, ht, index, i, v_next, False) <= margin
 
 
 @_inlined
@@ -534,10 +564,15 @@ def _step(solver_code, k, f, params, iparams, model, work, out, scratch):
     serve every solver)."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
+    driven = model[M_DRIVEN].shape[0] > 0  # (a scene without driven bodies skips their calls: measurably faster)
+    if model[M_MOTIONS].shape[0] > 0:
+        drive_step(k, params, model)
     na = begin_step(params, qk, vk, f, model, work)
     if na < 0:
         counters[K_FAIL_CONTACT] = -1 - na
         return RUN_BAD_GEOMETRY
+    if driven:
+        hold_driven_velocities(model, work)
     p, u, states = scratch[S_FLOATS][:0], scratch[S_FLOATS][:0], scratch[S_STATES][:0]  # no contact: no arrays
     if na > 0:
         status, p, u, states = solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out[2], out[3],
@@ -545,7 +580,42 @@ def _step(solver_code, k, f, params, iparams, model, work, out, scratch):
         if status != KERNEL_SOLVED:
             counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
-    return finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out)
+    status = finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out)
+    if driven:
+        place_driven_bodies(k, model, out)
+    return status
+
+
+@_inlined
+def drive_step(k, params, model):
+    """Step k's driven obstacles and bodies: the motions at its start and end (the compiled ones;
+    the step-wise loop wrote the Python ones), the driven obstacles' contact rows moved there."""
+    t = step_time(params, k)
+    evaluate_motions(t, t + params[P_H], model[M_MOTIONS], model[M_MOTION_TIMES], model[M_MOTION_VALUES],
+                     model[M_MOTION_NOW])
+    drive_contacts(model[2], model[M_MOTION_NOW])
+
+
+@_inlined
+def hold_driven_velocities(model, work):
+    """A driven body's free velocity is its prescribed velocity at the step's end: with M⁻¹ = 0 no
+    force or impulse changes it, so the contacts see it move as prescribed."""
+    driven, now, v_free = model[M_DRIVEN], model[M_MOTION_NOW], work[8]
+    for r in range(driven.shape[0]):
+        j, m = 3 * driven[r, 0], driven[r, 1]
+        for d in range(3):
+            v_free[j + d] = now[m, NOW_VELOCITY + d]
+
+
+@_inlined
+def place_driven_bodies(k, model, out):
+    """A driven body's end-of-step state is its prescribed one (not the θ-method's quadrature of it)."""
+    driven, origin, now, q, v = model[M_DRIVEN], model[M_DRIVEN_ORIGIN], model[M_MOTION_NOW], out[0], out[1]
+    for r in range(driven.shape[0]):
+        j, m = 3 * driven[r, 0], driven[r, 1]
+        for d in range(3):
+            q[k + 1, j + d] = origin[r, d] + now[m, NOW_END + d]
+            v[k + 1, j + d] = now[m, NOW_VELOCITY + d]
 
 
 @_inlined
@@ -688,5 +758,6 @@ def compiled_step(k, f, params, iparams, model, work, out):
 
 
 __all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "finish_step", "step_force", "run_steps", "compiled_step",
+           "drive_step", "hold_driven_velocities", "place_driven_bodies",
            "crossing_offset", "ACTIVATION_ROUNDOFF"]
 

@@ -203,6 +203,10 @@ def _segment_as_polygon_parts(seg: Segment):
 
 
 def _polygon_segment(poly, body, name, seg, seg_name, law):
+    if getattr(seg, "motion", None) is not None:  # its vertex–edge rows are fixed geometry
+        raise InputError(f"segment {seg_name!r} moves (motion) and a polygon ({name}) collides with it: found "
+                         "polygon–segment contacts do not follow a driven segment yet; use a driven line, or "
+                         "collide = false and declare point-on-segment contacts")
     depth = DEPTH_FRACTION * poly.width
     sides, ends = _segment_as_polygon_parts(seg)
     found = []

@@ -38,13 +38,18 @@ KIND_VERTEX_ON_EDGE, KIND_FIXED_VERTEX_ON_EDGE = 4, 5
 # (C_DEPTH_LIMIT); the edge's start in C_OFF_B* and unit direction in C_EDGE_T* (the edge
 # owner's frame; world when fixed), its length in C_SEGMENT_LENGTH.
 C_CONE_1X, C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_TIE_WINS, C_DEPTH_LIMIT = range(19, 25)
-N_CONTACT_COLUMNS = 25
 # A vertex within SEAM_TOL × the edge's length of an end of the edge is at that end. An edge
 # normal within FACE_TOL (a sine: 1°) of a boundary of the vertex's normal cone is on it: the
 # vertex's edge and the edge face each other, and both of its ends may touch — counting only the
 # nearer end of two faces tilted by less would drop a face's second support as it rocks (the far
 # end, just outside its cone, is then farther than the near one by the tilt: no wrong contact).
 SEAM_TOL, FACE_TOL = 1e-9, 0.0175
+# A driven obstacle (model/motion.py): the motion moving it (−1: none, a float holding an index),
+# the obstacle point C_LINE_P* at rest (C_LINE_P* itself is its place at the step's start) and its
+# velocity (world frame) at the step's end and at its start, which the step subtracts from the
+# contact's relative velocity at the end (the law) and at the start (activation, u_N before impact).
+C_MOTION, C_BASE_PX, C_BASE_PY, C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY = range(25, 32)
+N_CONTACT_COLUMNS = 32
 
 
 @jitable
@@ -262,6 +267,14 @@ def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
     drift_n = -om_b * om_b * (gap + r) + 2.0 * om_b * (tx * wx + ty * wy) + nx * accx + ny * accy
     drift_t = om_b * (nx * wx + ny * wy) + ny * accx - nx * accy
     return gap, drift_n, drift_t
+
+
+@jitable
+def obstacle_velocity(nx, ny, tx, ty, wx, wy, surface):
+    """(w_N, w_T): an obstacle's velocity w (a driven obstacle's) along the contact's normal n and
+    tangent t, plus a belt's surface velocity along t — what the relative velocity subtracts from
+    H v. Scalars: the compiled loop reads them from its tables without making array views."""
+    return nx * wx + ny * wy, tx * wx + ty * wy + surface
 
 
 @jitable

@@ -28,7 +28,9 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_
                               C_EDGE_TX, C_EDGE_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT,
                               KIND_SEGMENT_END_ON_EDGE, N_CONTACT_COLUMNS, kinematics_kernel, C_CONE_1X,
                               C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_DEPTH_LIMIT, C_TIE_WINS, KIND_VERTEX_ON_EDGE,
-                              KIND_FIXED_VERTEX_ON_EDGE)
+                              KIND_FIXED_VERTEX_ON_EDGE, C_OBSTACLE_VX, C_OBSTACLE_VY,
+                              C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, obstacle_velocity)
+from .motion import require_motion
 from .laws import ContactLaw
 
 
@@ -38,17 +40,21 @@ class Line:
 
     `angle` is the inclination of the line to +x (radians, counter-clockwise); the normal is the
     tangent turned by +90°, so angle = 0 is the floor y = point[1] with normal +y and tangent +x.
-    `velocity` lets the surface move along its tangent (a belt) without moving the line.
+    `velocity` lets the surface move along its tangent (a belt) without moving the line;
+    `motion` (model/motion.py: Harmonic, Tabulated, Prescribed) translates the line in time
+    (a shaken floor), d(t) from `point`.
     """
 
     point: tuple[float, float] = (0.0, 0.0)
     angle: float = 0.0
     velocity: float = 0.0
+    motion: object = None
 
     def __post_init__(self):
         require_finite("line angle", self.angle)
         require_finite("line velocity", self.velocity)
         object.__setattr__(self, "point", require_point("line point", self.point))
+        require_motion("line", self.motion, (2,))
 
     @property
     def tangent(self) -> tuple[float, float]:
@@ -65,13 +71,16 @@ class Segment:
 
     Its tangent runs from a to b and its normal is the tangent turned by +90° (a → b along +x:
     normal +y); a disk touches the side it is on, or an end point when it is beyond one.
+    `motion` (model/motion.py) translates it in time, d(t) from its placement.
     """
 
     a: tuple[float, float]
     b: tuple[float, float]
     name: str = "segment"
+    motion: object = None
 
     def __post_init__(self):
+        require_motion(f"segment {self.name!r}", self.motion, (2,))
         object.__setattr__(self, "a", require_point(f"segment {self.name!r} a", self.a))
         object.__setattr__(self, "b", require_point(f"segment {self.name!r} b", self.b))
         if self.length == 0.0:
@@ -113,6 +122,7 @@ class ContactKinematics:
     drift_N: float  # Ḣ_N v
     drift_T: float  # Ḣ_T v
     surface_velocity: float = 0.0  # subtracted from H_T v to get the slip velocity
+    normal_velocity: float = 0.0  # a driven obstacle's, subtracted from H_N v to get u_N
 
 
 # Each relation's packed row, by id, beside a weak reference that tells a live relation from a
@@ -148,10 +158,19 @@ class _PackedRelation:
         _PACKED_ROWS[key] = (ref, (kind, body_a, body_b, row))
         return kind, body_a, body_b, row
 
-    def kinematics(self, q, v, n_dof: int) -> ContactKinematics:
+    obstacle_motion = None  # a driven obstacle's motion (model/motion.py), by the relations that have one
+
+    def kinematics(self, q, v, n_dof: int, t: float | None = None) -> ContactKinematics:
         """The kernel of this contact's kind at (q, v): arrays, or lists (Scene.kinematics hands
-        lists, converted once for all contacts: the interpreter reads Python floats fastest)."""
+        lists, converted once for all contacts: the interpreter reads Python floats fastest).
+        A driven obstacle is taken at its place and velocity at time t (at rest when t is None)."""
         kind, body_a, body_b, row = self._packed_row()
+        if t is not None and self.obstacle_motion is not None:
+            row = list(row)
+            d, w = self.obstacle_motion.at(t)
+            row[C_LINE_PX], row[C_LINE_PY] = row[C_LINE_PX] + d[0], row[C_LINE_PY] + d[1]
+            row[C_OBSTACLE_VX], row[C_OBSTACLE_VY] = w[0], w[1]  # (at_start reads the same: one instant)
+            row[C_OBSTACLE_START_VX], row[C_OBSTACLE_START_VY] = w[0], w[1]
         q = q if isinstance(q, list) else np.asarray(q, dtype=float).tolist()
         v = v if isinstance(v, list) else np.asarray(v, dtype=float).tolist()
         hn, ht = [0.0] * 6, [0.0] * 6
@@ -162,7 +181,9 @@ class _PackedRelation:
         for side, body in enumerate((body_a, body_b)):
             for d in range(3 if body >= 0 else 0):  # element by element: cheaper than a slice
                 H_N[3 * body + d], H_T[3 * body + d] = hn[3 * side + d], ht[3 * side + d]
-        return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, row[C_SURFACE_VELOCITY])
+        w_n, w_t = obstacle_velocity(hn[0], hn[1], ht[0], ht[1], row[C_OBSTACLE_VX], row[C_OBSTACLE_VY],
+                                     row[C_SURFACE_VELOCITY])  # n, t: hn[0:2], ht[0:2] (body a's side)
+        return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, w_t, w_n)
 
 
 def _fill_disk_a(row, offset, radius) -> None:
@@ -202,6 +223,10 @@ class DiskOnLine(_PackedRelation):
     def bodies(self) -> tuple[int, ...]:
         return (self.body,)
 
+    @property
+    def obstacle_motion(self):
+        return self.line.motion
+
     def fill_row(self, row) -> tuple[int, int, int]:
         """Writes the geometry into a packed row; returns (kind, body a, body b)."""
         _fill_disk_a(row, self.offset, self.radius)
@@ -240,6 +265,10 @@ class DiskOnSegment(_PackedRelation):
     @property
     def bodies(self) -> tuple[int, ...]:
         return (self.body,)
+
+    @property
+    def obstacle_motion(self):
+        return self.segment.motion
 
     def fill_row(self, row) -> tuple[int, int, int]:
         """Writes the geometry into a packed row; returns (kind, body a, body b)."""
@@ -290,6 +319,10 @@ class SegmentEndOnEdge(_PackedRelation):
     @property
     def bodies(self) -> tuple[int, ...]:
         return (self.body,)
+
+    @property
+    def obstacle_motion(self):
+        return self.segment.motion
 
     def fill_row(self, row) -> tuple[int, int, int]:
         """Writes the geometry into a packed row; returns (kind, body a, body b)."""

@@ -21,8 +21,11 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, 
                               C_OFF_BX, C_OFF_BY, C_RADIUS_A, C_RADIUS_B, C_RESTITUTION, C_SEGMENT_LENGTH,
                               C_SURFACE_VELOCITY, C_TX, C_TY, KIND_DISK_ON_DISK, KIND_DISK_ON_LINE,
                               KIND_DISK_ON_SEGMENT, N_CONTACT_COLUMNS, kinematics_kernel, C_EDGE_TX, C_EDGE_TY,
-                              KIND_FIXED_VERTEX_ON_EDGE, KIND_SEGMENT_END_ON_EDGE, KIND_VERTEX_ON_EDGE)
+                              KIND_FIXED_VERTEX_ON_EDGE, KIND_SEGMENT_END_ON_EDGE, KIND_VERTEX_ON_EDGE,
+                              C_MOTION, C_BASE_PX, C_BASE_PY,
+                              C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY)
 from .forces import pack_forces
+from .motion import NOW_START, NOW_START_VELOCITY, NOW_VELOCITY, pack_motions
 
 # Int columns: kind, body a, body b (−1 for a fixed obstacle).
 CI_KIND, CI_BODY_A, CI_BODY_B = range(3)
@@ -42,6 +45,11 @@ class PackedScene:
     disk_body: np.ndarray  # (n_disks,) int64; −1: a fixed circle (offset in the world frame)
     pair_keys: np.ndarray  # (n_pairs,) int64 sorted: min(disk a, disk b) · n_disks + max(...)
     pair_contact: np.ndarray  # (n_pairs,) int64: the contact of each key
+    motions: list = None  # model/motion.py: every motion of a driven obstacle or body, by index
+    motion_table: np.ndarray = None  # (n_motions, N_MOTION_COLUMNS), with motion_times, motion_values
+    motion_times: np.ndarray = None
+    motion_values: np.ndarray = None
+    driven: np.ndarray = None  # (n_driven, 2) int64: body, its motion
 
     @property
     def n_contacts(self) -> int:
@@ -115,14 +123,40 @@ def pack_disk_pairs(table, index):
             np.array(owners, dtype=np.int64)[order])
 
 
+def pack_drives(scene, table, index, minv):
+    """The motions of the driven obstacles (their contacts' C_MOTION, C_BASE_P*) and bodies (their
+    M⁻¹ rows zero: infinite mass): (motions, motion table, times, values, driven (body, motion))."""
+    motions, number = [], {}
+
+    def motion_index(motion):
+        if id(motion) not in number:
+            number[id(motion)] = len(motions)
+            motions.append(motion)
+        return number[id(motion)]
+
+    table[:, C_MOTION] = -1.0
+    for i, c in enumerate(scene.contacts):
+        if getattr(c, "obstacle_motion", None) is not None:
+            table[i, C_MOTION] = motion_index(c.obstacle_motion)
+            table[i, C_BASE_PX], table[i, C_BASE_PY] = table[i, C_LINE_PX], table[i, C_LINE_PY]
+    driven = np.array([(d.body, motion_index(d.motion)) for d in scene.driven], dtype=np.int64).reshape(-1, 2)
+    for body in driven[:, 0]:
+        minv[3 * body: 3 * body + 3] = 0.0
+    for i, c in enumerate(scene.contacts):
+        if all(minv[3 * b] == 0.0 for b in index[i, CI_BODY_A:CI_BODY_B + 1] if b >= 0):
+            raise InputError(f"contact {c.name}: every body it touches is driven, so nothing it pushes can move")
+    return (motions, *pack_motions(motions), driven)
+
+
 def pack_scene(scene) -> PackedScene:
     table, index = pack_contacts(scene.contacts, len(scene.bodies))
     forces = pack_forces(getattr(scene, "forces", ()))
     if forces[1].size and int(forces[1][:, 1:3].max()) >= len(scene.bodies):
         raise InputError(f"forces: a body index is beyond the scene's {len(scene.bodies)} bodies")
-    return PackedScene(np.ascontiguousarray(scene.inverse_mass_diagonal, dtype=float),
-                       np.ascontiguousarray(scene.weight, dtype=float), table, index, *forces,
-                       *pack_disk_pairs(table, index))
+    minv = np.array(scene.inverse_mass_diagonal, dtype=float)
+    drives = pack_drives(scene, table, index, minv)
+    return PackedScene(minv, np.ascontiguousarray(scene.weight, dtype=float), table, index, *forces,
+                       *pack_disk_pairs(table, index), *drives)
 
 
 @jit
@@ -131,6 +165,22 @@ def contact_kinematics(table, index, i, q, v, hn, ht):
     gap, drift_n, _ = kinematics_kernel(index[i, CI_KIND], table[i], index[i, CI_BODY_A], index[i, CI_BODY_B],
                                         q, v, hn, ht)
     return gap, drift_n
+
+
+@jit
+def drive_contacts(table, now):
+    """Each driven obstacle's contact rows at this step: its place at the step's start (C_LINE_P*)
+    and its velocity at the step's end and start (C_OBSTACLE_V*, C_OBSTACLE_START_V*), from the
+    motions' evaluation `now`."""
+    for i in range(table.shape[0]):
+        m = int(table[i, C_MOTION])
+        if m >= 0:
+            table[i, C_LINE_PX] = table[i, C_BASE_PX] + now[m, NOW_START]
+            table[i, C_LINE_PY] = table[i, C_BASE_PY] + now[m, NOW_START + 1]
+            table[i, C_OBSTACLE_VX] = now[m, NOW_VELOCITY]
+            table[i, C_OBSTACLE_VY] = now[m, NOW_VELOCITY + 1]
+            table[i, C_OBSTACLE_START_VX] = now[m, NOW_START_VELOCITY]
+            table[i, C_OBSTACLE_START_VY] = now[m, NOW_START_VELOCITY + 1]
 
 
 @jit

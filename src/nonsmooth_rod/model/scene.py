@@ -6,10 +6,20 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..validation import InputError, quoted, require_finite, require_name
+from ..validation import InputError, quoted, require_finite, require_name, require_point
 from .body import RigidBody
 
 AppliedForce = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+
+
+def gravity_vector(gravity) -> tuple[float, float]:
+    """(gx, gy) of a scene's `gravity`: a number g ≥ 0 means (0, −g); a pair is the vector."""
+    if isinstance(gravity, (list, tuple, np.ndarray)):
+        return require_point("gravity", gravity)
+    g = require_finite("g", gravity)
+    if g < 0:
+        raise InputError(f"g must be non-negative (or give the vector (gx, gy)), got {quoted(gravity)}")
+    return (0.0, -g)
 
 
 @dataclass
@@ -22,14 +32,13 @@ class Scene:
 
     bodies: Sequence[RigidBody]
     contacts: Sequence = ()
-    gravity: float = 9.81
+    gravity: float | tuple[float, float] = 9.81  # g downward (−y), or the vector (gx, gy)
     applied_force: AppliedForce | None = None
     forces: Sequence = ()  # model.forces: Spring, Damper, ConstantForce, RampedForce, TabulatedForce
+    driven: Sequence = ()  # model.motion.DrivenBody: bodies whose placement is prescribed in time
 
     def __post_init__(self):
-        require_finite("g", self.gravity)
-        if self.gravity < 0:
-            raise InputError(f"g must be non-negative, got {quoted(self.gravity)}")
+        self.gravity_vector = gravity_vector(self.gravity)
         if not self.bodies:
             raise InputError("a scene needs at least one body")
         self.bodies = list(self.bodies)
@@ -42,10 +51,12 @@ class Scene:
                 raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce or "
                                  f"TabulatedForce, got {type(force).__name__}")
         self._check_references()
+        self._check_driven()
         self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
         self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
         self.weight = np.zeros(self.n_dof)
-        self.weight[1::3] = -self.gravity * self.mass_diagonal[0::3]
+        self.weight[0::3] = self.gravity_vector[0] * self.mass_diagonal[0::3]
+        self.weight[1::3] = self.gravity_vector[1] * self.mass_diagonal[0::3]
 
     def _check_references(self) -> None:
         """Every contact names bodies that exist; contact names are unique (phases are keyed by them)."""
@@ -78,13 +89,39 @@ class Scene:
                     raise InputError(f"forces[{i}] ({force.name!r}) {attr} refers to body {body}, but the scene "
                                      f"has {len(self.bodies)} bodies")
 
+    def _check_driven(self) -> None:
+        from .motion import DrivenBody
+
+        self.driven = list(self.driven)
+        seen = set()
+        for i, d in enumerate(self.driven):
+            if not isinstance(d, DrivenBody):
+                raise InputError(f"driven[{i}] must be a DrivenBody(body, motion), got {type(d).__name__}")
+            if d.body >= len(self.bodies) or d.body in seen:
+                raise InputError(f"driven[{i}]: body {d.body} is beyond the scene's {len(self.bodies)} bodies "
+                                 f"or driven twice")
+            seen.add(d.body)
+
+    def driven_things(self) -> list[str]:
+        """Names of what moves by a prescribed motion: driven obstacles' contacts and driven bodies."""
+        names = [f"contact {c.name!r}" for c in self.contacts if getattr(c, "obstacle_motion", None) is not None]
+        return names + [f"body {self.bodies[d.body].name!r}" for d in self.driven]
+
+    def python_motions(self) -> bool:
+        """True when a driven obstacle or body follows a Python (Prescribed) motion."""
+        from .motion import Prescribed
+
+        motions = [getattr(c, "obstacle_motion", None) for c in self.contacts] + [d.motion for d in self.driven]
+        return any(isinstance(m, Prescribed) for m in motions)
+
     def forces_vary_in_time(self) -> bool:
         """True when the applied force may change while the state does not (a Python
-        `applied_force`, a RampedForce or a TabulatedForce): a body at rest need not stay so."""
+        `applied_force`, a RampedForce or a TabulatedForce) or an obstacle or body is driven:
+        a body at rest need not stay so."""
         from .forces import RampedForce, TabulatedForce
 
         return self.applied_force is not None or any(isinstance(f, (RampedForce, TabulatedForce))
-                                                     for f in self.forces)
+                                                     for f in self.forces) or bool(self.driven_things())
 
     @property
     def n_dof(self) -> int:
@@ -115,7 +152,10 @@ class Scene:
         return 0.5 * float(np.dot(self.mass_diagonal * v, v))
 
     def potential_energy(self, q: np.ndarray) -> float:
-        return self.gravity * float(np.dot(self.mass_diagonal[0::3], q[1::3]))
+        """−Σ m g·x over the bodies' centres of mass (m g y for gravity g downward)."""
+        gx, gy = self.gravity_vector
+        m = self.mass_diagonal[0::3]
+        return -(gx * float(np.dot(m, q[0::3])) + gy * float(np.dot(m, q[1::3])))
 
     def energy(self, q: np.ndarray, v: np.ndarray) -> float:
         """Kinetic + gravitational energy (applied forces are not included)."""

@@ -127,11 +127,13 @@ def scene_extent(result, sf) -> tuple[float, float, float, float]:
     return x0 - widen, x1 + widen, y0 - lift, y1 + lift
 
 
-def draw_lines(ax, sf, extent=None) -> None:
-    """Each line of the scene: its own `length` if the file gives one, else across the extent."""
+def draw_lines(ax, sf, extent=None) -> list:
+    """Each line of the scene: its own `length` if the file gives one, else across the extent.
+    Returns (artist, motion) of the driven lines and segments (drawn at rest: moved per frame)."""
     if extent is not None and not isinstance(extent, tuple):  # a matplotlib Bbox
         extent = (extent.x0, extent.x1, extent.y0, extent.y1)
     tables = {t.get("name"): t for t in sf.data.get("lines", []) if isinstance(t, dict)}
+    driven = []
     for name, line in sf.lines.items():
         length = tables.get(name, {}).get("length")
         if length is None:
@@ -141,19 +143,33 @@ def draw_lines(ax, sf, extent=None) -> None:
         t, n = np.array(line.tangent), np.array(line.normal)
         p = np.array(line.point)
         ends = np.array([p - t * length / 2, p + t * length / 2])
-        ax.plot(ends[:, 0], ends[:, 1], color="0.3", lw=2, zorder=1)
+        artists = ax.plot(ends[:, 0], ends[:, 1], color="0.3", lw=2, zorder=1)
         below = 0.008 * (max(extent[1] - extent[0], extent[3] - extent[2]) if extent else length)
         hatch = np.array([ends[0] - below * n, ends[1] - below * n])
-        ax.plot(hatch[:, 0], hatch[:, 1], color="0.7", lw=4, zorder=0)
-    draw_segments(ax, sf)
+        artists += ax.plot(hatch[:, 0], hatch[:, 1], color="0.7", lw=4, zorder=0)
+        driven += [(art, line.motion) for art in artists if line.motion is not None]
+    return driven + draw_segments(ax, sf)
 
 
-def draw_segments(ax, sf) -> None:
-    """Each segment of the scene from end to end, its ends marked (a segment has two sides)."""
+def draw_segments(ax, sf) -> list:
+    """Each segment of the scene from end to end, its ends marked (a segment has two sides);
+    returns (artist, motion) of the driven ones."""
+    driven = []
     for segment in getattr(sf, "segments", {}).values():
         ends = np.array([segment.a, segment.b])
-        ax.plot(ends[:, 0], ends[:, 1], color="0.3", lw=2.5, solid_capstyle="butt", zorder=1)
-        ax.plot(ends[:, 0], ends[:, 1], "o", color="0.3", ms=3, zorder=1)
+        artists = ax.plot(ends[:, 0], ends[:, 1], color="0.3", lw=2.5, solid_capstyle="butt", zorder=1)
+        artists += ax.plot(ends[:, 0], ends[:, 1], "o", color="0.3", ms=3, zorder=1)
+        driven += [(art, segment.motion) for art in artists if segment.motion is not None]
+    return driven
+
+
+def move_driven(ax, driven, t: float) -> None:
+    """The driven lines' and segments' artists at their place at time t."""
+    from matplotlib.transforms import Affine2D
+
+    for art, motion in driven:
+        d = motion.at(t)[0]
+        art.set_transform(Affine2D().translate(d[0], d[1]) + ax.transData)
 
 
 def _make_artists(ax, sf) -> list:
@@ -305,7 +321,7 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
     shown = shown_contacts(result)
     status = StatusText([name for _, name in shown])
     fig, ax = _frame_figure(extent, status.lines, dpi)
-    draw_lines(ax, sf, extent)
+    driven = draw_lines(ax, sf, extent)
     bodies = _make_artists(ax, sf)
     scale = _force_scale(result, extent)
     arrows = ax.quiver(np.zeros(len(sf.scene.contacts)), np.zeros(len(sf.scene.contacts)),
@@ -330,6 +346,7 @@ def build_animation(result, sf=None, frames: int = 120, fps: int = 25, dpi: int 
             arrows.set_offsets(pts)
             arrows.set_UVC(vec[:, 0], vec[:, 1])
         label.set_text(status.text(tr.t[i], [tr.modes[i, k] for k, _ in shown]))
+        move_driven(ax, driven, float(tr.t[i]))
         return []
 
     return animation.FuncAnimation(fig, update, frames=len(indices), interval=1000 / fps, blit=False)

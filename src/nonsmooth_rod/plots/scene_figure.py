@@ -52,10 +52,10 @@ def _paths(ax, result, names) -> None:
         ax.plot(q[0, 3 * i], q[0, 3 * i + 1], "o", color=ax.lines[-1].get_color(), ms=4)
     sf = getattr(result, "scene_file", None)
     if sf is not None:
-        from .animation import draw_lines, scene_extent
+        from .animation import draw_lines, move_driven, scene_extent
 
         extent = scene_extent(result, sf)
-        draw_lines(ax, sf, extent)
+        move_driven(ax, draw_lines(ax, sf, extent), float(result.trajectory.t[0]))  # driven: at the start
         ax.set(xlim=extent[:2], ylim=extent[2:])
     ax.set(xlabel="x [m]", ylabel="y [m]", title="paths of the centres of mass (o: start)")
     ax.set_aspect("equal", adjustable="box")

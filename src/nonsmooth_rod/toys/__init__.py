@@ -28,10 +28,11 @@ from .disk import DiskOnIncline
 from .indeterminate import DiskPyramid, Ladder, WedgedRod
 from .painleve import PainleveRod
 from .rocking_block import RockingBlock, impact_rate_pairs
+from .shaken import BallOnShakenPlate, ShakenBlock
 
 __all__ = [
     "run", "BouncingBall", "BlockOnIncline", "PushedBlock", "DiskOnIncline", "BeltOscillator",
     "RockingBlock", "PainleveRod", "BallRow", "ball_height", "rest_time", "slope_motion",
     "first_slip_time", "stick_slip_phases", "impact_rate_pairs", "ball_velocities", "save_figure",
-    "example_parser", "Ladder", "WedgedRod", "DiskPyramid",
+    "example_parser", "Ladder", "WedgedRod", "DiskPyramid", "ShakenBlock", "BallOnShakenPlate",
 ]
