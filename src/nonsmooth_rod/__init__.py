@@ -15,7 +15,8 @@ from .driver import StopAtImpact, simulate
 from .model.body import RigidBody
 from .model.contacts import (DiskOnDisk, DiskOnLine, DiskOnSegment, Line, PointOnLine, PointOnSegment, Segment,
                              SegmentEndOnEdge)
-from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce
+from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce, Torque, TorsionSpring
+from .model.joints import Pin, Slider
 from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
 from .model.scene import Scene
 from .results import ContactState, Event, Impact, Phase, SimulationResult, Status, Trajectory
@@ -48,5 +49,6 @@ __all__ = [
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
     "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",
-    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "sweep", "fit",
+    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "TorsionSpring", "Torque", "Pin",
+    "Slider", "sweep", "fit",
 ]

@@ -27,6 +27,10 @@ METHODS = {
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
 }
 
+# The methods that take bilateral joints (model/joints.py); the driver refuses a jointed scene for
+# the others, naming a joint.
+HANDLES_JOINTS = ("moreau-jean",)
+
 
 def supported_contacts(method: str) -> tuple[str, ...]:
     """Names of the contact relation classes a method handles."""
@@ -57,5 +61,5 @@ def check_output_size(samples: float, scene, knob: str = "save_every or a shorte
     return needed
 
 
-__all__ = ["METHODS", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes", "sample_bytes",
+__all__ = ["METHODS", "HANDLES_JOINTS", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes", "sample_bytes",
            "supported_contacts"]

@@ -25,6 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
+from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, joint_arrays
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
@@ -85,15 +86,24 @@ def loop_kernels(compiled: bool):
     return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
 
 
-def _model_and_work(packed, resume: ResumeState | None):
-    """The model and work tuples of moreau_jean_loop; the contact memory from `resume`."""
+def _joint_work(joints):
+    """The work arrays of the joints (moreau_jean_loop.WORK_JOINT_*) from their model arrays."""
+    table, _, dofs, slot = joints
+    rows = ROWS_PER_JOINT * table.shape[0]
+    return (np.zeros((rows, slot.shape[0])), np.zeros(rows), np.zeros((rows, rows)),
+            np.zeros((dofs.shape[0], dofs.shape[0])), np.zeros(rows))
+
+
+def _model_and_work(packed, resume: ResumeState | None, joints):
+    """The model and work tuples of moreau_jean_loop; the contact memory from `resume`; `joints`
+    the model arrays of the scene's joints (model.joints.joint_arrays)."""
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
     model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
              packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
-             packed.pair_keys, packed.pair_contact)
+             packed.pair_keys, packed.pair_contact) + joints
     work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
             np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-            np.zeros(n_dof), np.zeros(nc, dtype=np.int64))
+            np.zeros(n_dof), np.zeros(nc, dtype=np.int64)) + _joint_work(joints)
     if resume is not None:
         work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
             resume.was_closed, resume.grazing, resume.slip_sign
@@ -201,10 +211,10 @@ class MoreauJean:
                 raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
         grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
-        model, work = _model_and_work(packed, resume)
-        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)))
+        model, work = _model_and_work(packed, resume, joint_arrays(scene.joints, len(scene.bodies)))
+        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
-        collector = Collector(grid, scene.n_dof, len(names), save_every, resume)
+        collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         params, iparams = self._parameters(grid, names)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         engine = Engine(bool(opts.fast and _jit.ENABLED),
@@ -410,11 +420,19 @@ class MoreauJean:
                      solver_fallbacks=int(counters[loop.K_FALLBACKS]))
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, events,
                                   impacts, phases, steps=n_done, cpu_time_s=cpu, stats=stats)
+        result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
         result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
         return result
+
+
+def joint_forces(joints, impulses_over_h) -> dict:
+    """{joint name: {reaction: samples}}: a pin's world force (Fx, Fy) on body_a, a slider's force
+    F along its line's normal and torque M on body_a (N, N·m: the step's impulses / h)."""
+    return {joint.name: {what: impulses_over_h[:, ROWS_PER_JOINT * i + r]
+                         for r, what in enumerate(REACTION_NAMES[joint.kind])} for i, joint in enumerate(joints)}
 
 
 _KERNEL_FAILURES = {1: "no valid solution of the step problem (secondary ray)",

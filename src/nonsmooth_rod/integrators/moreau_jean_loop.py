@@ -35,6 +35,7 @@ def _inlined(function):
 
     return numba.njit(cache=True, inline="always")(function)
 from ..model.forces import accumulate_forces
+from .joint_step import constrained_delassus, joint_operators, project_onto_joints, project_positions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
                              KIND_DISK_ON_DISK,
                              contact_kinematics, local_dot)
@@ -71,6 +72,14 @@ N_COUNTERS = 10
 P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0, P_H_GRID = range(7)
 N_PARAMS = 7
 I_SOLVER, I_MAX_ITER, I_STOP = range(3)
+# Slots of the joints (joint_step.py) in the model, work and out tuples, after the others.
+# model: joint table and index (model/joints.pack_joints), the dofs of the jointed bodies and
+# each dof's position among them (−1: not jointed).
+M_JOINTS, M_JOINT_INDEX, M_JOINT_DOFS, M_DOF_SLOT = 12, 13, 14, 15
+# work: J and C at q_k, A⁺ = (J M⁻¹ Jᵀ)⁺, W_c over the jointed dofs, the multipliers projecting v_free.
+WORK_JOINT_J, WORK_JOINT_C, WORK_JOINT_A_PINV, WORK_JOINT_WC, WORK_JOINT_FREE = 11, 12, 13, 14, 15
+# out: each step's joint impulses (rows × 2 per joint).
+O_JOINT_IMPULSE = 10
 
 
 @jit
@@ -136,6 +145,8 @@ def begin_step(params, qk, vk, f, model, work):
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
         v_free[d] = vk[d] + h * a_free[d]
+    if model[M_JOINTS].shape[0] > 0:
+        _joints_begin(qk, model, work)
     broad = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
     if broad:
         broad_phase(h, qk, vk, model[8], model[9], model[10], model[11], was_closed, candidate)
@@ -287,6 +298,9 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             q_step[2 * a] = local_dot(hn[i], index, i, v_free) + table[i, C_RESTITUTION] * min(u_n, 0.0)
             u_t = local_dot(ht[i], index, i, vk) - surface  # a closing contact slides the way it arrives
             guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
+    if model[M_JOINTS].shape[0] > 0:
+        work_wc = work[WORK_JOINT_WC]
+        constrained_delassus(na, work[4], work[2], work[3], index, minv, model[M_DOF_SLOT], work_wc, W)
 
 
 @jit
@@ -347,10 +361,15 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
                 for d in range(3):
                     v_next[3 * body + d] += minv[3 * body + d] * (hn[i, 3 * side + d] * p[2 * a]
                                                                   + ht[i, 3 * side + d] * p[2 * a + 1])
+    joints = model[M_JOINTS].shape[0] > 0
+    if joints:
+        _joints_finish(k, v_next, model, work, out)
     finite = True
     for d in range(qk.shape[0]):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
+    if joints and finite:
+        _joints_project(q[k + 1], model, work)
     status = RUN_OK
     for i in range(table.shape[0]):
         p_normal[k, i] = 0.0
@@ -383,6 +402,33 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
 
 
 @jit
+def _joints_begin(qk, model, work):
+    """The joints at q_k (J, A⁺, W_c) and the free velocity and acceleration projected onto them."""
+    minv, J, A_pinv = model[0], work[WORK_JOINT_J], work[WORK_JOINT_A_PINV]
+    joint_operators(qk, minv, model[M_JOINTS], model[M_JOINT_INDEX], model[M_JOINT_DOFS], J,
+                    work[WORK_JOINT_C], A_pinv, work[WORK_JOINT_WC])
+    project_onto_joints(work[8], minv, J, A_pinv, work[WORK_JOINT_FREE])
+    project_onto_joints(work[9], minv, J, A_pinv, np.empty(J.shape[0]))
+
+
+@jit
+def _joints_finish(k, v_next, model, work, out):
+    """v_{k+1} projected onto the joints (J v_{k+1} = 0) and step k's joint impulses recorded."""
+    impulse = out[O_JOINT_IMPULSE][k]
+    project_onto_joints(v_next, model[0], work[WORK_JOINT_J], work[WORK_JOINT_A_PINV], impulse)
+    free = work[WORK_JOINT_FREE]
+    for r in range(impulse.shape[0]):
+        impulse[r] += free[r]
+
+
+@jit
+def _joints_project(q_next, model, work):
+    """q_{k+1} projected back onto the joints' positions C(q) = 0 (their drift stays round-off)."""
+    project_positions(q_next, model[0], model[M_JOINTS], model[M_JOINT_INDEX], model[M_JOINT_DOFS],
+                      work[WORK_JOINT_J], work[WORK_JOINT_C], work[WORK_JOINT_A_PINV])
+
+
+@jit
 def _rides_the_gap(i, params, work, index, v_next):
     """A persistent contact that got no impulse but ends the step within h² |g̈| of
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
@@ -411,7 +457,8 @@ def _warm_start(k, na, work, out, p):
 def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out):
     """assemble + the two-coefficient kernel. Returns (kernel status, p, u, states, consistent)."""
     m = 2 * na
-    sparse = solver_code == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
+    # pgs sweeps the block-sparse W; lemke, enum need it dense, and so do joints (W_c couples a cluster)
+    sparse = solver_code == SOLVER_PGS and model[M_JOINTS].shape[0] == 0
     W = np.zeros((0, 0)) if sparse else np.zeros((m, m))
     q_step = np.empty(m)
     guess, mu_s, mu_d, closing, resting = np.empty(na), np.empty(na), np.empty(na), np.empty(na), np.empty(na)

@@ -25,6 +25,7 @@ class Scene:
     gravity: float = 9.81
     applied_force: AppliedForce | None = None
     forces: Sequence = ()  # model.forces: Spring, Damper, ConstantForce, RampedForce, TabulatedForce
+    joints: Sequence = ()  # model.joints: Pin, Slider
 
     def __post_init__(self):
         require_finite("g", self.gravity)
@@ -39,9 +40,11 @@ class Scene:
         self.forces = list(self.forces)
         for i, force in enumerate(self.forces):
             if not isinstance(force, FORCE_TYPES):
-                raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce or "
-                                 f"TabulatedForce, got {type(force).__name__}")
+                raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce, "
+                                 f"TabulatedForce or TorsionSpring, got {type(force).__name__}")
+        self.joints = list(self.joints)
         self._check_references()
+        self._check_joints()
         self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
         self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
         self.weight = np.zeros(self.n_dof)
@@ -77,6 +80,24 @@ class Scene:
                 if body is not None and body >= len(self.bodies):
                     raise InputError(f"forces[{i}] ({force.name!r}) {attr} refers to body {body}, but the scene "
                                      f"has {len(self.bodies)} bodies")
+
+    def _check_joints(self) -> None:
+        """Joints are Pin or Slider on bodies that exist, with unique names."""
+        from .joints import JOINT_TYPES
+
+        seen = set()
+        for i, joint in enumerate(self.joints):
+            if not isinstance(joint, JOINT_TYPES):
+                raise InputError(f"joints[{i}] must be a Pin or a Slider, got {type(joint).__name__}")
+            require_name(f"joints[{i}] name", joint.name)
+            if joint.name in seen:
+                raise InputError(f"two joints are named {joint.name!r}: joint names must be unique")
+            seen.add(joint.name)
+            for attr in ("body_a", "body_b"):
+                body = getattr(joint, attr)
+                if body is not None and body >= len(self.bodies):
+                    raise InputError(f"joint {joint.name!r} {attr} refers to body {body}, but the scene has "
+                                     f"{len(self.bodies)} bodies")
 
     def forces_vary_in_time(self) -> bool:
         """True when the applied force may change while the state does not (a Python

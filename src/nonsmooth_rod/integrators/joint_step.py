@@ -1,0 +1,177 @@
+"""Bilateral joints inside a Moreau–Jean step: their rows eliminated (docs/joints.md).
+
+With the joints' Jacobian J = ∂C/∂q at q_k (model/joints.py) and A = J M⁻¹ Jᵀ, the step's end
+velocity is v_{k+1} = v_free + M⁻¹Hᵀp + M⁻¹Jᵀλ with J v_{k+1} = 0, so
+
+    λ = −A⁺ J (v_free + M⁻¹Hᵀp),   v_{k+1} = P (v_free + M⁻¹Hᵀp),   P = I − M⁻¹JᵀA⁺J,
+
+and the contacts see u = H P v_free + H W_c Hᵀ p with the constrained inverse mass
+W_c = P M⁻¹ = M⁻¹ − M⁻¹JᵀA⁺JM⁻¹: exactly the contact problem of a scene without joints, with
+the free velocity projected and W_c in place of M⁻¹. W_c is dense over the dofs of the jointed
+bodies only (two contacts on different bodies of one jointed cluster couple), diagonal
+elsewhere. A⁺ is a pseudo-inverse (eigenvalues of A below EIGEN_CUTOFF of the largest are
+dropped): redundant joints — a body pinned twice at one point — share the load, never NaN.
+
+After the step, the positions are projected back onto C(q) = 0 by Newton's iteration in the
+mass metric, Δq = −M⁻¹JᵀA⁺C(q): the joints' drift stays at round-off however long the run.
+Every function takes plain arrays; moreau_jean_loop unpacks its tuples into them.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import jit
+from ..model.joints import joint_rows
+from ..model.packing import CI_BODY_A
+
+# Relative size (to A's largest eigenvalue) below which an eigenvalue of A = J M⁻¹ Jᵀ counts as
+# zero: a redundant joint's rows make A singular up to round-off (~1e-16 of its scale).
+EIGEN_CUTOFF = 1e-10
+# Newton iterations of the position projection (quadratic: 2–3 reach round-off after a step).
+MAX_PROJECTION_ITERATIONS = 8
+# A joint's violation below this many ulps of the largest coordinate is round-off: done.
+PROJECTION_ULPS = 4.0
+
+
+@jit
+def pseudo_inverse(A, A_pinv):
+    """A_pinv = A⁺ of the symmetric positive semi-definite A (eigenvalues ≤ EIGEN_CUTOFF λ_max dropped)."""
+    n = A.shape[0]
+    A_pinv[:, :] = 0.0
+    if n == 0:
+        return
+    values, vectors = np.linalg.eigh(A)
+    top = max(values[n - 1], 0.0)
+    for m in range(n):
+        if values[m] > EIGEN_CUTOFF * top and values[m] > 0.0:
+            inv = 1.0 / values[m]
+            for r in range(n):
+                for s in range(n):
+                    A_pinv[r, s] += vectors[r, m] * inv * vectors[s, m]
+
+
+@jit
+def joint_operators(q, minv, table, index, dofs, J, C, A_pinv, WC):
+    """J and C at q, A⁺ = (J M⁻¹ Jᵀ)⁺ and, when WC is given (non-empty), W_c over the jointed dofs."""
+    joint_rows(table, index, q, J, C)
+    nr, nd = J.shape[0], dofs.shape[0]
+    A = np.zeros((nr, nr))
+    for r in range(nr):
+        for s in range(r, nr):
+            x = 0.0
+            for a in range(nd):
+                d = dofs[a]
+                x += J[r, d] * minv[d] * J[s, d]
+            A[r, s] = x
+            A[s, r] = x
+    pseudo_inverse(A, A_pinv)
+    if WC.shape[0] == 0:
+        return
+    B = np.empty((nd, nr))  # M⁻¹Jᵀ over the jointed dofs
+    for a in range(nd):
+        for r in range(nr):
+            B[a, r] = minv[dofs[a]] * J[r, dofs[a]]
+    BA = B @ A_pinv
+    for a in range(nd):
+        for b in range(a, nd):
+            x = 0.0
+            for r in range(nr):
+                x += BA[a, r] * B[b, r]
+            w = (minv[dofs[a]] if a == b else 0.0) - x
+            WC[a, b] = w
+            WC[b, a] = w
+
+
+@jit
+def project_onto_joints(x, minv, J, A_pinv, lam):
+    """x ← P x = x + M⁻¹Jᵀλ with λ = −A⁺ J x (returned in lam): the velocity closest to x in the
+    mass metric that the joints allow."""
+    nr = J.shape[0]
+    Jx = J @ x
+    for r in range(nr):
+        s = 0.0
+        for c in range(nr):
+            s -= A_pinv[r, c] * Jx[c]
+        lam[r] = s
+    for d in range(x.shape[0]):
+        s = 0.0
+        for r in range(nr):
+            s += J[r, d] * lam[r]
+        x[d] += minv[d] * s
+
+
+@jit
+def _constrained_product(row_i, index, i, row_j, j, minv, slot, WC):
+    """row_i W_c row_jᵀ for two contacts' 6-entry rows (W_c: M⁻¹ off the jointed dofs)."""
+    s = 0.0
+    for side_i in range(2):
+        body_i = index[i, CI_BODY_A + side_i]
+        if body_i < 0:
+            continue
+        for side_j in range(2):
+            body_j = index[j, CI_BODY_A + side_j]
+            if body_j < 0:
+                continue
+            for d in range(3):
+                di = 3 * body_i + d
+                for e in range(3):
+                    dj = 3 * body_j + e
+                    if slot[di] >= 0 and slot[dj] >= 0:
+                        w = WC[slot[di], slot[dj]]
+                    elif di == dj:
+                        w = minv[di]
+                    else:
+                        continue
+                    s += row_i[3 * side_i + d] * w * row_j[3 * side_j + e]
+    return s
+
+
+@jit
+def constrained_delassus(na, active, hn, ht, index, minv, slot, WC, W):
+    """The dense Delassus matrix H W_c Hᵀ over the active contacts (overwrites W)."""
+    for a in range(na):
+        i = active[a]
+        for b in range(na):
+            j = active[b]
+            W[2 * a, 2 * b] = _constrained_product(hn[i], index, i, hn[j], j, minv, slot, WC)
+            W[2 * a, 2 * b + 1] = _constrained_product(hn[i], index, i, ht[j], j, minv, slot, WC)
+            W[2 * a + 1, 2 * b] = _constrained_product(ht[i], index, i, hn[j], j, minv, slot, WC)
+            W[2 * a + 1, 2 * b + 1] = _constrained_product(ht[i], index, i, ht[j], j, minv, slot, WC)
+
+
+@jit
+def project_positions(q, minv, table, index, dofs, J, C, A_pinv):
+    """Newton's iteration in the mass metric, q ← q − M⁻¹JᵀA⁺C(q), until the joints' violation
+    is round-off of the coordinates (or stops decreasing); returns the violation max |C| left."""
+    scale = 1.0
+    for d in range(q.shape[0]):
+        scale = max(scale, abs(q[d]))
+    tol = PROJECTION_ULPS * 2.220446049250313e-16 * scale
+    no_wc = np.zeros((0, 0))
+    lam = np.empty(J.shape[0])
+    before = math.inf
+    for _ in range(MAX_PROJECTION_ITERATIONS):
+        joint_operators(q, minv, table, index, dofs, J, C, A_pinv, no_wc)
+        violation = 0.0
+        for r in range(C.shape[0]):
+            violation = max(violation, abs(C[r]))
+        if violation <= tol or not violation < before:
+            return violation
+        before = violation
+        # the Newton step is P applied to a "velocity" whose constraint image is C: solve J Δq = −C
+        for r in range(C.shape[0]):
+            s = 0.0
+            for c in range(C.shape[0]):
+                s -= A_pinv[r, c] * C[c]
+            lam[r] = s
+        for d in range(q.shape[0]):
+            s = 0.0
+            for r in range(C.shape[0]):
+                s += J[r, d] * lam[r]
+            q[d] += minv[d] * s
+    return before
+
+
+__all__ = ["joint_operators", "project_onto_joints", "constrained_delassus", "project_positions", "pseudo_inverse"]
