@@ -182,3 +182,46 @@ def test_a_qp_backend_solves_the_jointed_step_too():
     assert res.status == "ok"
     (impact,) = res.impacts
     assert impact.v_after[2] / impact.v_before[2] == pytest.approx(-0.5, abs=1e-4)
+
+
+def pin_force_about_a_fixed_pivot(theta, mass=M, length=L, g=G):
+    """The force (x, y) a fixed pivot applies to a uniform rod released at rest horizontal, at its
+    angle θ (from +x, the rod swinging down: θ ≤ 0)."""
+    arm, inertia = length / 2, mass * length ** 2 / 3
+    rate2 = 2 * mass * g * arm * -np.sin(theta) / inertia
+    accel = -mass * g * arm * np.cos(theta) / inertia
+    ax = arm * (accel * -np.sin(theta) - rate2 * np.cos(theta))
+    ay = arm * (accel * np.cos(theta) - rate2 * np.sin(theta))
+    return mass * ax, mass * ay + mass * g
+
+
+def test_pendulum_on_a_cart_holds_the_cart_until_friction_cannot_and_slips_at_the_closed_form_angle():
+    """A cart on two frictional feet carries a rod pinned at its centre, released horizontal. While
+    the cart sticks the rod swings about a fixed pivot, whose force R on the rod the cart feels as
+    −R: the feet hold while |R_x| ≤ μs (M_cart g + R_y), and slip at the first angle where equality
+    holds (brentq on the closed form)."""
+    from scipy.optimize import brentq
+
+    cart_mass, mu_s = 5.0, 0.05
+    ratio = lambda th: abs(pin_force_about_a_fixed_pivot(th)[0]) / (cart_mass * G + pin_force_about_a_fixed_pivot(th)[1])
+    theta_slip = brentq(lambda th: ratio(th) - mu_s, -0.6, -1e-3)
+    law = nr.ContactLaw.of(mu_s, mu_s, 0.0)
+    floor = nr.Line((0.0, 0.0), 0.0)
+    half_width, half_height = 0.4, 0.1
+    cart = nr.RigidBody(cart_mass, cart_mass * (4 * half_width ** 2 + 4 * half_height ** 2) / 12, name="cart")
+    feet = [nr.PointOnLine(1, (side * half_width, -half_height), floor, law, name=f"foot{i}")
+            for i, side in enumerate((-1, 1))]
+    scene = nr.Scene([nr.RigidBody(M, M * L * L / 12, name="rod"), cart], feet, gravity=G,
+                     joints=[nr.Pin(0, (-L / 2, 0.0), 1, (0.0, 0.0), name="hinge")])
+    q0 = np.array([L / 2, half_height, 0.0, 0.0, half_height, 0.0])
+    h = 1e-4
+    res = nr.simulate(scene, q0, np.zeros(6), 0.35, h=h)
+    assert res.status == "ok"
+    moving = np.flatnonzero(np.abs(res.v[:, 3]) > 1e-9)
+    k = moving[0]
+    theta_at_slip = np.interp(res.t[k - 1], res.t, res.q[:, 2])
+    assert np.max(np.abs(res.q[:k, 3])) < 1e-12  # the cart held until then
+    # within the step's turn (ω h ≈ 1.9e-4 rad) and the O(h) lag of the step's mean force (measured
+    # 1.4e-4 rad at h = 1e-4)
+    assert theta_at_slip == pytest.approx(theta_slip, abs=5e-4)
+    assert res.phases["foot0"][0].mode == "stick" and res.phases["foot0"][1].mode.startswith("slip")

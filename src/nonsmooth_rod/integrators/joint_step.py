@@ -13,7 +13,8 @@ elsewhere. A⁺ is a pseudo-inverse (eigenvalues of A below EIGEN_CUTOFF of the 
 dropped): redundant joints — a body pinned twice at one point — share the load, never NaN.
 
 After the step, the positions are projected back onto C(q) = 0 by Newton's iteration in the
-mass metric, Δq = −M⁻¹JᵀA⁺C(q): the joints' drift stays at round-off however long the run.
+mass metric, Δq = −M⁻¹GᵀA⁺[C(q); 0], G = [J; the rows of the contacts that held in the step]:
+the joints' drift stays at round-off however long the run, and what the contacts held stays.
 Every function takes plain arrays; moreau_jean_loop unpacks its tuples into them.
 """
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 from .._jit import jit
 from ..model.joints import joint_rows
 from ..model.packing import CI_BODY_A
+from ..solvers.two_coefficient import STATE_OPEN, STATE_STICK
 
 # Relative size (to A's largest eigenvalue) below which an eigenvalue of A = J M⁻¹ Jᵀ counts as
 # zero: a redundant joint's rows make A singular up to round-off (~1e-16 of its scale).
@@ -142,36 +144,82 @@ def constrained_delassus(na, active, hn, ht, index, minv, slot, WC, W):
 
 
 @jit
-def project_positions(q, minv, table, index, dofs, J, C, A_pinv):
-    """Newton's iteration in the mass metric, q ← q − M⁻¹JᵀA⁺C(q), until the joints' violation
-    is round-off of the coordinates (or stops decreasing); returns the violation max |C| left."""
+def held_contact_rows(na, active, states, hn, ht, index, slot, rows, bodies):
+    """The contact rows the position projection must not move (rows, bodies filled; returns their
+    count): of the contacts closed this step on a jointed body, the normal row, and the tangent
+    row of a sticking one."""
+    m = 0
+    for a in range(na):
+        i = active[a]
+        jointed = False
+        for side in range(2):
+            body = index[i, CI_BODY_A + side]
+            jointed = jointed or (body >= 0 and slot[3 * body] >= 0)
+        if states[a] == STATE_OPEN or not jointed:
+            continue
+        for which in range(2 if states[a] == STATE_STICK else 1):
+            rows[m, :] = hn[i] if which == 0 else ht[i]
+            bodies[m, 0], bodies[m, 1] = index[i, CI_BODY_A], index[i, CI_BODY_A + 1]
+            m += 1
+    return m
+
+
+@jit
+def _projection_system(q, minv, table, index, J, C, held, held_bodies, n_held, G, target):
+    """G = [J(q); the held contact rows], target = [C(q); 0]; returns max |C|."""
+    joint_rows(table, index, q, J, C)
+    nr = J.shape[0]
+    G[:, :] = 0.0
+    G[:nr, :] = J
+    violation = 0.0
+    for r in range(nr):
+        target[r] = C[r]
+        violation = max(violation, abs(C[r]))
+    for m in range(n_held):
+        target[nr + m] = 0.0
+        for side in range(2):
+            body = held_bodies[m, side]
+            if body >= 0:
+                for d in range(3):
+                    G[nr + m, 3 * body + d] = held[m, 3 * side + d]
+    return violation
+
+
+@jit
+def project_positions(q, minv, table, index, J, C, held, held_bodies, n_held):
+    """Newton's iteration in the mass metric, q ← q − M⁻¹GᵀA⁺[C(q); 0] with G = [J; held contact
+    rows] and A = G M⁻¹ Gᵀ: the joints' violation goes back to round-off of the coordinates (or
+    stops decreasing) while the contacts that held this step keep their gap and, sticking, their
+    point (a cart held by friction is not pushed along by its pendulum's correction). Returns
+    the violation max |C| left."""
+    n = q.shape[0]
     scale = 1.0
-    for d in range(q.shape[0]):
+    for d in range(n):
         scale = max(scale, abs(q[d]))
     tol = PROJECTION_ULPS * 2.220446049250313e-16 * scale
-    no_wc = np.zeros((0, 0))
-    lam = np.empty(J.shape[0])
+    rows = J.shape[0] + n_held
+    G, target, A, A_pinv = np.zeros((rows, n)), np.zeros(rows), np.empty((rows, rows)), np.empty((rows, rows))
     before = math.inf
     for _ in range(MAX_PROJECTION_ITERATIONS):
-        joint_operators(q, minv, table, index, dofs, J, C, A_pinv, no_wc)
-        violation = 0.0
-        for r in range(C.shape[0]):
-            violation = max(violation, abs(C[r]))
+        violation = _projection_system(q, minv, table, index, J, C, held, held_bodies, n_held, G, target)
         if violation <= tol or not violation < before:
             return violation
         before = violation
-        # the Newton step is P applied to a "velocity" whose constraint image is C: solve J Δq = −C
-        for r in range(C.shape[0]):
-            s = 0.0
-            for c in range(C.shape[0]):
-                s -= A_pinv[r, c] * C[c]
-            lam[r] = s
-        for d in range(q.shape[0]):
-            s = 0.0
-            for r in range(C.shape[0]):
-                s += J[r, d] * lam[r]
-            q[d] += minv[d] * s
+        for r in range(rows):
+            for c in range(r, rows):
+                x = 0.0
+                for d in range(n):
+                    x += G[r, d] * minv[d] * G[c, d]
+                A[r, c] = x
+                A[c, r] = x
+        pseudo_inverse(A, A_pinv)
+        lam = A_pinv @ target
+        for d in range(n):
+            x = 0.0
+            for r in range(rows):
+                x += G[r, d] * lam[r]
+            q[d] -= minv[d] * x
     return before
 
 
-__all__ = ["joint_operators", "project_onto_joints", "constrained_delassus", "project_positions", "pseudo_inverse"]
+__all__ = ["joint_operators", "project_onto_joints", "constrained_delassus", "project_positions", "held_contact_rows", "pseudo_inverse"]

@@ -35,7 +35,8 @@ def _inlined(function):
 
     return numba.njit(cache=True, inline="always")(function)
 from ..model.forces import accumulate_forces
-from .joint_step import constrained_delassus, joint_operators, project_onto_joints, project_positions
+from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, project_onto_joints,
+                         project_positions)
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
                              KIND_DISK_ON_DISK,
                              contact_kinematics, local_dot)
@@ -369,7 +370,7 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
     if joints and finite:
-        _joints_project(q[k + 1], model, work)
+        _joints_project(q[k + 1], na, states, model, work)
     status = RUN_OK
     for i in range(table.shape[0]):
         p_normal[k, i] = 0.0
@@ -422,10 +423,14 @@ def _joints_finish(k, v_next, model, work, out):
 
 
 @jit
-def _joints_project(q_next, model, work):
-    """q_{k+1} projected back onto the joints' positions C(q) = 0 (their drift stays round-off)."""
-    project_positions(q_next, model[0], model[M_JOINTS], model[M_JOINT_INDEX], model[M_JOINT_DOFS],
-                      work[WORK_JOINT_J], work[WORK_JOINT_C], work[WORK_JOINT_A_PINV])
+def _joints_project(q_next, na, states, model, work):
+    """q_{k+1} projected back onto the joints' positions C(q) = 0 (their drift stays round-off),
+    the contacts that held this step kept where they are."""
+    hn, ht, active, slot = work[2], work[3], work[4], model[M_DOF_SLOT]
+    held, held_bodies = np.empty((2 * na, 6)), np.empty((2 * na, 2), dtype=np.int64)
+    n_held = held_contact_rows(na, active, states, hn, ht, model[3], slot, held, held_bodies)
+    project_positions(q_next, model[0], model[M_JOINTS], model[M_JOINT_INDEX], work[WORK_JOINT_J],
+                      work[WORK_JOINT_C], held, held_bodies, n_held)
 
 
 @jit
