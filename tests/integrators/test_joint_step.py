@@ -203,8 +203,11 @@ def test_pendulum_on_a_cart_holds_the_cart_until_friction_cannot_and_slips_at_th
     from scipy.optimize import brentq
 
     cart_mass, mu_s = 5.0, 0.05
-    ratio = lambda th: abs(pin_force_about_a_fixed_pivot(th)[0]) / (cart_mass * G + pin_force_about_a_fixed_pivot(th)[1])
-    theta_slip = brentq(lambda th: ratio(th) - mu_s, -0.6, -1e-3)
+    def friction_needed(theta):  # |T| / N the feet must supply to hold the cart
+        fx, fy = pin_force_about_a_fixed_pivot(theta)
+        return abs(fx) / (cart_mass * G + fy)
+
+    theta_slip = brentq(lambda th: friction_needed(th) - mu_s, -0.6, -1e-3)
     law = nr.ContactLaw.of(mu_s, mu_s, 0.0)
     floor = nr.Line((0.0, 0.0), 0.0)
     half_width, half_height = 0.4, 0.1

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 import nonsmooth_rod as nr
-from nonsmooth_rod.model.joints import joint_violation, pack_joints, joint_rows, ROWS_PER_JOINT
+from nonsmooth_rod.model.joints import ROWS_PER_JOINT, joint_rows, joint_violation, pack_joints
 from nonsmooth_rod.solvers._common import interpreted
 
 
 def _rows(joints, q):
-    table, index = pack_joints(joints, len(q) // 3)
+    table = pack_joints(joints, len(q) // 3)
     J, C = np.zeros((ROWS_PER_JOINT * len(joints), len(q))), np.zeros(ROWS_PER_JOINT * len(joints))
-    interpreted(joint_rows)(table, index, np.asarray(q, float), J, C)
+    interpreted(joint_rows)(table, np.asarray(q, float), J, C)
     return J, C
 
 

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from .._jit import jit
-from ..model.joints import joint_rows
+from ..model.joints import ROWS_PER_JOINT, joint_rows, jointed_dofs
 from ..model.packing import CI_BODY_A
 from ..solvers.two_coefficient import STATE_OPEN, STATE_STICK
 
@@ -54,10 +54,27 @@ def pseudo_inverse(A, A_pinv):
                     A_pinv[r, s] += vectors[r, m] * inv * vectors[s, m]
 
 
+def work_size(table, n_dof: int) -> int:
+    """Floats of the joints' work buffer (joint_views) for the joint table and n_dof."""
+    rows, nd = ROWS_PER_JOINT * table.shape[0], jointed_dofs(table, n_dof)[0].shape[0]
+    return rows * n_dof + rows + rows * rows + nd * nd + rows
+
+
 @jit
-def joint_operators(q, minv, table, index, dofs, J, C, A_pinv, WC):
+def joint_views(buffer, rows, n_dof, nd):
+    """(J, C, A⁺, W_c, λ_free) as views of the one work buffer (work_size floats)."""
+    a = rows * n_dof
+    b = a + rows
+    c = b + rows * rows
+    d = c + nd * nd
+    return (buffer[:a].reshape((rows, n_dof)), buffer[a:b], buffer[b:c].reshape((rows, rows)),
+            buffer[c:d].reshape((nd, nd)), buffer[d:d + rows])
+
+
+@jit
+def joint_operators(q, minv, table, dofs, J, C, A_pinv, WC):
     """J and C at q, A⁺ = (J M⁻¹ Jᵀ)⁺ and, when WC is given (non-empty), W_c over the jointed dofs."""
-    joint_rows(table, index, q, J, C)
+    joint_rows(table, q, J, C)
     nr, nd = J.shape[0], dofs.shape[0]
     A = np.zeros((nr, nr))
     for r in range(nr):
@@ -165,9 +182,9 @@ def held_contact_rows(na, active, states, hn, ht, index, slot, rows, bodies):
 
 
 @jit
-def _projection_system(q, minv, table, index, J, C, held, held_bodies, n_held, G, target):
+def _projection_system(q, table, J, C, held, held_bodies, n_held, G, target):
     """G = [J(q); the held contact rows], target = [C(q); 0]; returns max |C|."""
-    joint_rows(table, index, q, J, C)
+    joint_rows(table, q, J, C)
     nr = J.shape[0]
     G[:, :] = 0.0
     G[:nr, :] = J
@@ -186,7 +203,7 @@ def _projection_system(q, minv, table, index, J, C, held, held_bodies, n_held, G
 
 
 @jit
-def project_positions(q, minv, table, index, J, C, held, held_bodies, n_held):
+def project_positions(q, minv, table, J, C, held, held_bodies, n_held):
     """Newton's iteration in the mass metric, q ← q − M⁻¹GᵀA⁺[C(q); 0] with G = [J; held contact
     rows] and A = G M⁻¹ Gᵀ: the joints' violation goes back to round-off of the coordinates (or
     stops decreasing) while the contacts that held this step keep their gap and, sticking, their
@@ -201,7 +218,7 @@ def project_positions(q, minv, table, index, J, C, held, held_bodies, n_held):
     G, target, A, A_pinv = np.zeros((rows, n)), np.zeros(rows), np.empty((rows, rows)), np.empty((rows, rows))
     before = math.inf
     for _ in range(MAX_PROJECTION_ITERATIONS):
-        violation = _projection_system(q, minv, table, index, J, C, held, held_bodies, n_held, G, target)
+        violation = _projection_system(q, table, J, C, held, held_bodies, n_held, G, target)
         if violation <= tol or not violation < before:
             return violation
         before = violation
@@ -222,4 +239,5 @@ def project_positions(q, minv, table, index, J, C, held, held_bodies, n_held):
     return before
 
 
-__all__ = ["joint_operators", "project_onto_joints", "constrained_delassus", "project_positions", "held_contact_rows", "pseudo_inverse"]
+__all__ = ["joint_operators", "project_onto_joints", "constrained_delassus", "project_positions", "held_contact_rows",
+           "pseudo_inverse", "work_size", "joint_views"]

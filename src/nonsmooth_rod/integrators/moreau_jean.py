@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
-from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, joint_arrays
+from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
@@ -35,6 +35,7 @@ from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
 from ..validation import Choice, Flag, InputError, Number, Text, check_options, option, require_positive, require_state
 from . import moreau_jean_loop as loop
+from .joint_step import work_size
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
@@ -86,24 +87,16 @@ def loop_kernels(compiled: bool):
     return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
 
 
-def _joint_work(joints):
-    """The work arrays of the joints (moreau_jean_loop.WORK_JOINT_*) from their model arrays."""
-    table, _, dofs, slot = joints
-    rows = ROWS_PER_JOINT * table.shape[0]
-    return (np.zeros((rows, slot.shape[0])), np.zeros(rows), np.zeros((rows, rows)),
-            np.zeros((dofs.shape[0], dofs.shape[0])), np.zeros(rows))
-
-
 def _model_and_work(packed, resume: ResumeState | None, joints):
     """The model and work tuples of moreau_jean_loop; the contact memory from `resume`; `joints`
-    the model arrays of the scene's joints (model.joints.joint_arrays)."""
+    the scene's joint table (model.joints.pack_joints)."""
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
     model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
              packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
-             packed.pair_keys, packed.pair_contact) + joints
+             packed.pair_keys, packed.pair_contact, joints)
     work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
             np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-            np.zeros(n_dof), np.zeros(nc, dtype=np.int64)) + _joint_work(joints)
+            np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
     if resume is not None:
         work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
             resume.was_closed, resume.grazing, resume.slip_sign
@@ -211,7 +204,7 @@ class MoreauJean:
                 raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
         grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
-        model, work = _model_and_work(packed, resume, joint_arrays(scene.joints, len(scene.bodies)))
+        model, work = _model_and_work(packed, resume, pack_joints(scene.joints, len(scene.bodies)))
         window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))

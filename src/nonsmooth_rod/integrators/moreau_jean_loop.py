@@ -35,7 +35,8 @@ def _inlined(function):
 
     return numba.njit(cache=True, inline="always")(function)
 from ..model.forces import accumulate_forces
-from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, project_onto_joints,
+from ..model.joints import ROWS_PER_JOINT, jointed_dofs
+from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
                          project_positions)
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, C_SURFACE_VELOCITY, CI_BODY_A, CI_KIND,
                              KIND_DISK_ON_DISK,
@@ -73,12 +74,11 @@ N_COUNTERS = 10
 P_H, P_THETA, P_GAMMA, P_T0, P_RTOL, P_K0, P_H_GRID = range(7)
 N_PARAMS = 7
 I_SOLVER, I_MAX_ITER, I_STOP = range(3)
-# Slots of the joints (joint_step.py) in the model, work and out tuples, after the others.
-# model: joint table and index (model/joints.pack_joints), the dofs of the jointed bodies and
-# each dof's position among them (−1: not jointed).
-M_JOINTS, M_JOINT_INDEX, M_JOINT_DOFS, M_DOF_SLOT = 12, 13, 14, 15
-# work: J and C at q_k, A⁺ = (J M⁻¹ Jᵀ)⁺, W_c over the jointed dofs, the multipliers projecting v_free.
-WORK_JOINT_J, WORK_JOINT_C, WORK_JOINT_A_PINV, WORK_JOINT_WC, WORK_JOINT_FREE = 11, 12, 13, 14, 15
+# Slots of the joints (joint_step.py) in the model, work and out tuples, after the others (one
+# array each: every array of a tuple costs reference counting in every step, joints or not).
+# model: the joint table (model/joints.pack_joints); work: the joints' buffer (joint_step.joint_views).
+M_JOINTS = 12
+WORK_JOINTS = 11
 # out: each step's joint impulses (rows × 2 per joint).
 O_JOINT_IMPULSE = 10
 
@@ -146,8 +146,8 @@ def begin_step(params, qk, vk, f, model, work):
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
         v_free[d] = vk[d] + h * a_free[d]
-    if model[M_JOINTS].shape[0] > 0:
-        _joints_begin(qk, model, work)
+    if model[M_JOINTS].shape[0] > 0:  # (arrays, not the tuples: a call with them costs every step)
+        _joints_begin(qk, minv, model[M_JOINTS], work[WORK_JOINTS], v_free, a_free)
     broad = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
     if broad:
         broad_phase(h, qk, vk, model[8], model[9], model[10], model[11], was_closed, candidate)
@@ -300,8 +300,7 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             u_t = local_dot(ht[i], index, i, vk) - surface  # a closing contact slides the way it arrives
             guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
     if model[M_JOINTS].shape[0] > 0:
-        work_wc = work[WORK_JOINT_WC]
-        constrained_delassus(na, work[4], work[2], work[3], index, minv, model[M_DOF_SLOT], work_wc, W)
+        _joints_delassus(na, active, hn, ht, index, minv, model[M_JOINTS], work[WORK_JOINTS], W)
 
 
 @jit
@@ -364,13 +363,13 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
                                                                   + ht[i, 3 * side + d] * p[2 * a + 1])
     joints = model[M_JOINTS].shape[0] > 0
     if joints:
-        _joints_finish(k, v_next, model, work, out)
+        _joints_finish(v_next, minv, model[M_JOINTS], work[WORK_JOINTS], out[O_JOINT_IMPULSE][k])
     finite = True
     for d in range(qk.shape[0]):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
     if joints and finite:
-        _joints_project(q[k + 1], na, states, model, work)
+        _joints_project(q[k + 1], na, states, active, hn, ht, index, minv, model[M_JOINTS], work[WORK_JOINTS])
     status = RUN_OK
     for i in range(table.shape[0]):
         p_normal[k, i] = 0.0
@@ -403,34 +402,47 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
 
 
 @jit
-def _joints_begin(qk, model, work):
-    """The joints at q_k (J, A⁺, W_c) and the free velocity and acceleration projected onto them."""
-    minv, J, A_pinv = model[0], work[WORK_JOINT_J], work[WORK_JOINT_A_PINV]
-    joint_operators(qk, minv, model[M_JOINTS], model[M_JOINT_INDEX], model[M_JOINT_DOFS], J,
-                    work[WORK_JOINT_C], A_pinv, work[WORK_JOINT_WC])
-    project_onto_joints(work[8], minv, J, A_pinv, work[WORK_JOINT_FREE])
-    project_onto_joints(work[9], minv, J, A_pinv, np.empty(J.shape[0]))
+def _joint_state(minv, table, buffer):
+    """(dofs, slot, J, C, A⁺, W_c, λ_free) of the joints: the jointed dofs and the buffer's views."""
+    n_dof = minv.shape[0]
+    dofs, slot = jointed_dofs(table, n_dof)
+    J, C, A_pinv, WC, free = joint_views(buffer, ROWS_PER_JOINT * table.shape[0], n_dof, dofs.shape[0])
+    return dofs, slot, J, C, A_pinv, WC, free
 
 
 @jit
-def _joints_finish(k, v_next, model, work, out):
-    """v_{k+1} projected onto the joints (J v_{k+1} = 0) and step k's joint impulses recorded."""
-    impulse = out[O_JOINT_IMPULSE][k]
-    project_onto_joints(v_next, model[0], work[WORK_JOINT_J], work[WORK_JOINT_A_PINV], impulse)
-    free = work[WORK_JOINT_FREE]
+def _joints_begin(qk, minv, table, buffer, v_free, a_free):
+    """The joints at q_k (J, A⁺, W_c) and the free velocity and acceleration projected onto them."""
+    dofs, _, J, C, A_pinv, WC, free = _joint_state(minv, table, buffer)
+    joint_operators(qk, minv, table, dofs, J, C, A_pinv, WC)
+    project_onto_joints(v_free, minv, J, A_pinv, free)
+    project_onto_joints(a_free, minv, J, A_pinv, np.empty(J.shape[0]))
+
+
+@jit
+def _joints_delassus(na, active, hn, ht, index, minv, table, buffer, W):
+    """W = H W_c Hᵀ over the active contacts: the contacts' Delassus matrix with the joints."""
+    _, slot, _, _, _, WC, _ = _joint_state(minv, table, buffer)
+    constrained_delassus(na, active, hn, ht, index, minv, slot, WC, W)
+
+
+@jit
+def _joints_finish(v_next, minv, table, buffer, impulse):
+    """v_{k+1} projected onto the joints (J v_{k+1} = 0) and the step's joint impulses recorded."""
+    _, _, J, _, A_pinv, _, free = _joint_state(minv, table, buffer)
+    project_onto_joints(v_next, minv, J, A_pinv, impulse)
     for r in range(impulse.shape[0]):
         impulse[r] += free[r]
 
 
 @jit
-def _joints_project(q_next, na, states, model, work):
+def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buffer):
     """q_{k+1} projected back onto the joints' positions C(q) = 0 (their drift stays round-off),
     the contacts that held this step kept where they are."""
-    hn, ht, active, slot = work[2], work[3], work[4], model[M_DOF_SLOT]
+    _, slot, J, C, _, _, _ = _joint_state(minv, table, buffer)
     held, held_bodies = np.empty((2 * na, 6)), np.empty((2 * na, 2), dtype=np.int64)
-    n_held = held_contact_rows(na, active, states, hn, ht, model[3], slot, held, held_bodies)
-    project_positions(q_next, model[0], model[M_JOINTS], model[M_JOINT_INDEX], work[WORK_JOINT_J],
-                      work[WORK_JOINT_C], held, held_bodies, n_held)
+    n_held = held_contact_rows(na, active, states, hn, ht, index, slot, held, held_bodies)
+    project_positions(q_next, minv, table, J, C, held, held_bodies, n_held)
 
 
 @jit

@@ -11,7 +11,7 @@ Each joint is two equality rows C(q) = 0:
   `angle` relative to body_b — C₁ = θ_a − θ_b − angle. Its multipliers are the force along n
   on body_a and the torque on body_a.
 
-`pack_joints` turns them into tables the compiled Moreau–Jean loop reads; `joint_rows` (one
+`pack_joints` turns them into the table the compiled Moreau–Jean loop reads; `joint_rows` (one
 kernel, compiled or interpreted) evaluates C(q) and the Jacobian J = ∂C/∂q — integrators/
 joint_step.py eliminates the rows inside each step (docs/joints.md).
 """
@@ -29,12 +29,10 @@ from .forces import _require_body, _require_point
 
 JOINT_PIN, JOINT_SLIDER = 0, 1
 ROWS_PER_JOINT = 2
-# Float columns of the packed joint table.
-J_PA_X, J_PA_Y, J_PB_X, J_PB_Y, J_AXIS_X, J_AXIS_Y, J_ANGLE = range(7)
-N_JOINT_COLUMNS = 7
-# Int columns: kind, body a, body b (−1: the world).
-JI_KIND, JI_BODY_A, JI_BODY_B = range(3)
-N_JOINT_INDEX_COLUMNS = 3
+# Columns of the packed joint table (one float64 row per joint: the compiled loop's model tuple
+# takes one array for every joint): geometry, then kind and bodies (small integers, exact as floats).
+J_PA_X, J_PA_Y, J_PB_X, J_PB_Y, J_AXIS_X, J_AXIS_Y, J_ANGLE, J_KIND, J_BODY_A, J_BODY_B = range(10)
+N_JOINT_COLUMNS = 10
 # What each joint's two multipliers are, by kind (trajectory.csv's column suffixes).
 REACTION_NAMES = {JOINT_PIN: ("Fx", "Fy"), JOINT_SLIDER: ("F", "M")}
 
@@ -95,40 +93,51 @@ class Slider:
 JOINT_TYPES = (Pin, Slider)
 
 
-def pack_joints(joints, n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
-    """(table (n, 7) float64, index (n, 3) int64) of the joints."""
+def pack_joints(joints, n_bodies: int) -> np.ndarray:
+    """The joints as one (n, N_JOINT_COLUMNS) float64 table (body_b −1: the world)."""
     joints = list(joints)
     table = np.zeros((len(joints), N_JOINT_COLUMNS))
-    index = np.zeros((len(joints), N_JOINT_INDEX_COLUMNS), dtype=np.int64)
     for i, joint in enumerate(joints):
         if not isinstance(joint, JOINT_TYPES):
             raise InputError(f"joints[{i}] must be a Pin or a Slider, got {type(joint).__name__}")
         if max(joint.body_a, -1 if joint.body_b is None else joint.body_b) >= n_bodies:
             raise InputError(f"joint {joint.name!r}: body index beyond the scene's {n_bodies} bodies")
-        index[i] = joint.kind, joint.body_a, -1 if joint.body_b is None else joint.body_b
+        table[i, [J_KIND, J_BODY_A, J_BODY_B]] = joint.kind, joint.body_a, -1 if joint.body_b is None else joint.body_b
         table[i, [J_PA_X, J_PA_Y]], table[i, [J_PB_X, J_PB_Y]] = joint.point_a, joint.point_b
         if isinstance(joint, Slider):
             table[i, [J_AXIS_X, J_AXIS_Y]], table[i, J_ANGLE] = joint.axis, joint.angle
-    return table, index
-
-
-def joint_arrays(joints, n_bodies: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """What the Moreau–Jean loop reads of the joints: (table, index) of pack_joints, the dofs of
-    the jointed bodies (ascending) and each dof's position among them (−1: not jointed)."""
-    table, index = pack_joints(joints, n_bodies)
-    bodies = sorted({int(b) for b in index[:, [JI_BODY_A, JI_BODY_B]].ravel() if b >= 0})
-    dofs = np.array([3 * b + d for b in bodies for d in range(3)], dtype=np.int64)
-    slot = np.full(3 * n_bodies, -1, dtype=np.int64)
-    slot[dofs] = np.arange(dofs.size)
-    return table, index, dofs, slot
+    return table
 
 
 def joint_violation(joints, n_bodies: int, q) -> np.ndarray:
     """C(q) of the joints (2 rows each: a pin's x, y gap; a slider's offset from its line and angle)."""
-    table, index = pack_joints(joints, n_bodies)
-    J, C = np.zeros((ROWS_PER_JOINT * len(index), 3 * n_bodies)), np.zeros(ROWS_PER_JOINT * len(index))
-    interpreted(joint_rows)(table, index, np.asarray(q, dtype=float), J, C)
+    table = pack_joints(joints, n_bodies)
+    J, C = np.zeros((ROWS_PER_JOINT * len(table), 3 * n_bodies)), np.zeros(ROWS_PER_JOINT * len(table))
+    interpreted(joint_rows)(table, np.asarray(q, dtype=float), J, C)
     return C
+
+
+@jit
+def jointed_dofs(table, n_dof):
+    """(dofs, slot): the dofs of the jointed bodies, ascending, and each dof's position among them
+    (−1: not jointed)."""
+    slot = np.full(n_dof, -1, dtype=np.int64)
+    for i in range(table.shape[0]):
+        for column in (J_BODY_A, J_BODY_B):
+            body = int(table[i, column])
+            if body >= 0:
+                for d in range(3):
+                    slot[3 * body + d] = 0
+    n = 0
+    for d in range(n_dof):
+        if slot[d] >= 0:
+            slot[d] = n
+            n += 1
+    dofs = np.empty(n, dtype=np.int64)
+    for d in range(n_dof):
+        if slot[d] >= 0:
+            dofs[slot[d]] = d
+    return dofs, slot
 
 
 @jit
@@ -177,17 +186,19 @@ def _slider_rows(row, a, b, q, J, r):
 
 
 @jit
-def joint_rows(table, index, q, J, C):
+def joint_rows(table, q, J, C):
     """C(q) (2 rows per joint) and its Jacobian J = ∂C/∂q (dense: rows × n_dof, overwritten)."""
     J[:, :] = 0.0
     for i in range(table.shape[0]):
         r = ROWS_PER_JOINT * i
-        if index[i, JI_KIND] == JOINT_PIN:
-            c0, c1 = _pin_rows(table[i], index[i, JI_BODY_A], index[i, JI_BODY_B], q, J, r)
+        row = table[i]
+        a, b = int(row[J_BODY_A]), int(row[J_BODY_B])
+        if int(row[J_KIND]) == JOINT_PIN:
+            c0, c1 = _pin_rows(row, a, b, q, J, r)
         else:
-            c0, c1 = _slider_rows(table[i], index[i, JI_BODY_A], index[i, JI_BODY_B], q, J, r)
+            c0, c1 = _slider_rows(row, a, b, q, J, r)
         C[r], C[r + 1] = c0, c1
 
 
-__all__ = ["Pin", "Slider", "JOINT_TYPES", "pack_joints", "joint_arrays", "joint_violation", "joint_rows", "JOINT_PIN", "JOINT_SLIDER",
-           "REACTION_NAMES", "ROWS_PER_JOINT"]
+__all__ = ["Pin", "Slider", "JOINT_TYPES", "pack_joints", "jointed_dofs", "joint_violation", "joint_rows",
+           "JOINT_PIN", "JOINT_SLIDER", "REACTION_NAMES", "ROWS_PER_JOINT"]
