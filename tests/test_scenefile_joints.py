@@ -1,6 +1,7 @@
 """Joints and the forces joints need in scene files: `[[joints]]` (pin, slider), `[[forces]]`
 kind torsion-spring and torque; every mistake one line naming the file and the key."""
 import copy
+import json
 import math
 from pathlib import Path
 
@@ -54,12 +55,14 @@ def test_joints_and_forces_read_by_name():
 
 
 def test_a_jointed_file_runs_and_writes_the_reactions_to_trajectory_csv(tmp_path):
-    sf = parse_scene(TWO_BODIES, "two.toml")
-    res = nr.simulate_scene(sf)
+    (tmp_path / "two.json").write_text(json.dumps(TWO_BODIES))
+    res = nr.simulate_scene(load_scene(tmp_path / "two.json"))
     assert res.status == "ok"
-    res.save(tmp_path)
-    header = (tmp_path / "trajectory.csv").read_text().splitlines()[0].split(",")
+    res.save(tmp_path / "out")
+    header = (tmp_path / "out" / "trajectory.csv").read_text().splitlines()[0].split(",")
     assert {"hinge.Fx", "hinge.Fy", "rail.F", "rail.M"} <= set(header)
+    loaded = nr.load(tmp_path / "out")  # read back by the scene file's joints
+    np.testing.assert_array_equal(loaded.joint_forces["rail"]["F"], res.joint_forces["rail"]["F"])
     # the rail is the only external vertical force but gravity: it carries the weights and the
     # vertical momentum change of the bodies, step by step
     momentum_rate = 1.0 * res.trajectory.a[1:, 1] + 2.0 * res.trajectory.a[1:, 4]

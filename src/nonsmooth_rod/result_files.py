@@ -356,7 +356,17 @@ def load(folder):
     result.end_state = _end_state_from(summary.get("end_state"), len(bodies) * 3, len(contacts), folder)
     copies = [folder / n for n in ("scene.toml", "scene.json") if (folder / n).exists()]
     result.scene_file = load_scene(copies[0], summary["scene"].get("overrides", ())) if copies else None
+    result.joint_forces = _joint_forces_from(cols, result.scene_file)
     return result
+
+
+def _joint_forces_from(cols: dict, sf) -> dict:
+    """The joints' reaction columns of trajectory.csv, by the scene file's joints (none without it)."""
+    from .model.joints import REACTION_NAMES
+
+    joints = sf.scene.joints if sf is not None else ()
+    return {j.name: {what: np.asarray(cols[f"{j.name}.{what}"], dtype=float) for what in REACTION_NAMES[j.kind]}
+            for j in joints if all(f"{j.name}.{what}" in cols for what in REACTION_NAMES[j.kind])}
 
 
 def _end_state_from(d, n_dof: int, n_contacts: int, folder):

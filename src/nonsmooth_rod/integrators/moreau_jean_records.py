@@ -72,8 +72,8 @@ class ResumeState:
         rows = {name: np.asarray(d[name], dtype=np.int64 if name in _INT_ARRAYS else float) for name in _ARRAYS}
         for name in ("q", "v"):
             rows[name] = rows[name].reshape(-1, n_dof)
-        for name in RECORDS:
-            rows[name] = rows[name].reshape(-1, n_contacts)
+        for name in RECORDS:  # one row per step before the end state (a scene may have no contacts)
+            rows[name] = rows[name].reshape(rows["q"].shape[0] - 1, n_contacts)
         return cls(float(d["origin"]), int(d["step"]), float(d["h"]), bool(d["on_grid"]), float(d["last_h"]),
                    **rows)
 
