@@ -16,7 +16,8 @@ from .model.body import RigidBody
 from .model.contacts import (DiskOnDisk, DiskOnLine, DiskOnSegment, Line, PointOnLine, PointOnSegment, Segment,
                              SegmentEndOnEdge, VertexOnEdge)
 from .model.collision import Disk, PairLaws, Polygon, Polyline, find_contacts
-from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce
+from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce, Torque, TorsionSpring
+from .model.joints import Pin, Slider
 from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
 from .model.motion import DrivenBody, Harmonic, Prescribed, Tabulated
 from .model.scene import Scene
@@ -51,6 +52,7 @@ __all__ = [
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",
     "ContactSolution", "SolverError", "InputError", "load", "load_scene", "simulate_scene",
-    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "sweep", "fit",
+    "Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "TorsionSpring", "Torque", "Pin",
+    "Slider", "sweep", "fit",
     "Harmonic", "Tabulated", "Prescribed", "DrivenBody",
 ]

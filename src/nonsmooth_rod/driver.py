@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _jit
-from .integrators import (METHODS, MAX_OUTPUT_BYTES, check_driven, check_output_size, integrator_classes,
-                          supported_contacts)
+from .integrators import (HANDLES_JOINTS, METHODS, MAX_OUTPUT_BYTES, check_driven, check_output_size,
+                          integrator_classes, supported_contacts)
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
 from .validation import InputError, quoted, require_finite, require_positive, require_state
@@ -117,6 +117,9 @@ def _method(method, scene: Scene):
             raise InputError(f"method {method!r} does not handle {type(contact).__name__} contacts "
                              f"(contact {contact.name!r}); it handles {', '.join(handled)}")
     check_driven(method, scene)
+    if getattr(scene, "joints", ()) and method not in HANDLES_JOINTS:
+        raise InputError(f"method {method!r} does not handle joints (joint {scene.joints[0].name!r}); "
+                         f"use {' or '.join(HANDLES_JOINTS)}")
     return integrator_classes(method)
 
 

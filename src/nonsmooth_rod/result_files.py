@@ -47,7 +47,8 @@ def body_names_of(result) -> list[str]:
 
 
 def trajectory_columns(result) -> dict:
-    """Ordered columns of trajectory.csv: t, q and v of every body, N, T, mode of every contact."""
+    """Ordered columns of trajectory.csv: t, q and v of every body, N, T, mode of every contact, the
+    reactions of every joint."""
     tr = result.trajectory
     cols = {"t": np.asarray(tr.t, dtype=float)}
     for i, name in enumerate(body_names_of(result)):
@@ -58,6 +59,9 @@ def trajectory_columns(result) -> dict:
         cols[f"{name}.N"] = tr.normal_force[:, k]
         cols[f"{name}.T"] = tr.tangential_force[:, k]
         cols[f"{name}.mode"] = [str(m) for m in tr.modes[:, k]]
+    for name, reactions in (getattr(result, "joint_forces", None) or {}).items():
+        for what, values in reactions.items():  # a pin's Fx, Fy; a slider's F, M (model/joints.py)
+            cols[f"{name}.{what}"] = np.asarray(values, dtype=float)
     return cols
 
 
@@ -188,6 +192,7 @@ def scene_description(result) -> dict | None:
         **({"segments": [{"name": n, "a": list(s.a), "b": list(s.b)} | _motion_data(s.motion)
                          for n, s in segments.items()]} if segments else {}),
         "contacts": contacts, "forces": [_force_data(f, bodies) for f in scene.forces],
+        "joints": [_force_data(j, bodies) for j in getattr(scene, "joints", ())],
         "applied_force": _plain(scene.applied_force),
         "initial": {n: {"q": q0[3 * i:3 * i + 3].tolist(), "v": v0[3 * i:3 * i + 3].tolist()}
                     for i, n in enumerate(bodies)},
@@ -375,7 +380,17 @@ def load(folder):
     result.end_state = _end_state_from(summary.get("end_state"), len(bodies) * 3, len(contacts), folder)
     copies = [folder / n for n in ("scene.toml", "scene.json") if (folder / n).exists()]
     result.scene_file = load_scene(copies[0], summary["scene"].get("overrides", ())) if copies else None
+    result.joint_forces = _joint_forces_from(cols, result.scene_file)
     return result
+
+
+def _joint_forces_from(cols: dict, sf) -> dict:
+    """The joints' reaction columns of trajectory.csv, by the scene file's joints (none without it)."""
+    from .model.joints import REACTION_NAMES
+
+    joints = sf.scene.joints if sf is not None else ()
+    return {j.name: {what: np.asarray(cols[f"{j.name}.{what}"], dtype=float) for what in REACTION_NAMES[j.kind]}
+            for j in joints if all(f"{j.name}.{what}" in cols for what in REACTION_NAMES[j.kind])}
 
 
 def _end_state_from(d, n_dof: int, n_contacts: int, folder):

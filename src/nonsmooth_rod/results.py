@@ -158,6 +158,8 @@ class SimulationResult:
     stats: dict = field(default_factory=dict)
     end_state: object = None
     setup: object = None
+    # {joint name: {reaction ("Fx", "Fy" of a pin; "F", "M" of a slider): samples}} (model/joints.py)
+    joint_forces: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.status = Status(self.status)

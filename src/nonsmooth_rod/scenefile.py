@@ -44,7 +44,7 @@ _REQUIRED = object()
 MAX_DEPTH = 16  # tables and lists nest at most this deep (a scene needs 4)
 
 TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "segments", "contacts", "forces",
-            "initial", "simulation", "laws")
+            "joints", "initial", "simulation", "laws")
 BODY_KEYS = ("name", "mass", "inertia", "shape", "density", "thickness", "radius", "width", "height",
              "length", "ball_radius", "rod_diameter", "vertices", "collide", "group")
 COLLISION_KEYS = ("collide", "group")  # scene_collisions.py: not dimensions of a shape
@@ -67,7 +67,12 @@ FORCE_KEYS = {
     "constant": ("kind", "name", "body", "force", "torque", "point"),
     "ramped": ("kind", "name", "body", "force", "torque", "point", "t_start", "t_full"),
     "tabulated": ("kind", "name", "body", "times", "forces", "torques", "point"),
+    "torsion-spring": ("kind", "name", "body", "body_b", "stiffness", "rest_angle_deg", "damping"),
+    "torque": ("kind", "name", "body", "torque"),
 }
+JOINT_KINDS = ("pin", "slider")
+JOINT_KEYS = {"pin": ("kind", "name", "body_a", "point_a", "body_b", "point_b"),
+              "slider": ("kind", "name", "body_a", "point_a", "body_b", "point_b", "axis", "angle_deg")}
 
 
 @dataclass
@@ -93,6 +98,7 @@ class SceneFile:
     text: str = ""  # the file as read (for a copy next to the results)
     overrides: list = field(default_factory=list)
     segments: dict = field(default_factory=dict)  # segment name -> Segment
+    joint_names: list = field(default_factory=list)
     save_every: float | None = None  # [simulation] save_every: one kept sample per this many seconds
 
 
@@ -440,6 +446,13 @@ def _contacts(w, data, body_names, lines, segments=None) -> list:
 
 def _force_fields(w, t, key, kind, body_names) -> dict:
     body = _lookup(w, body_names, t.get("body"), f"{key}.body", "body")
+    if kind == "torque":
+        return {"body": body, "torque": _number(w, t, "torque", key)}
+    if kind == "torsion-spring":
+        return {"body_a": body, "body_b": _other_body(w, t, key, body, body_names),
+                "stiffness": _number(w, t, "stiffness", key, nonnegative=True),
+                "rest_angle": math.radians(_number(w, t, "rest_angle_deg", key, 0.0)),
+                "damping": _number(w, t, "damping", key, 0.0, nonnegative=True)}
     point = _vector(w, t, "point", key, 2, [0.0, 0.0])
     if kind in ("spring", "damper"):
         other = None if "body_b" not in t else _lookup(w, body_names, t["body_b"], f"{key}.body_b", "body")
@@ -461,6 +474,16 @@ def _force_fields(w, t, key, kind, body_names) -> dict:
         if fields["t_full"] <= fields["t_start"]:
             raise w.error(f"{key}.t_full", f"must exceed t_start = {fields['t_start']:g}, got {fields['t_full']:g}")
     return fields
+
+
+def _other_body(w, t, key, body, body_names, name="body_b"):
+    """The second body of a two-body force or joint (None: the world), never the first."""
+    if name not in t:
+        return None
+    other = _lookup(w, body_names, t[name], f"{key}.{name}", "body")
+    if other == body:
+        raise w.error(f"{key}.{name}", "joins a body to itself; leave it out to join the body to the world")
+    return other
 
 
 def _table_fields(w, t, key) -> dict:
@@ -502,6 +525,45 @@ def _forces(w, data, body_names) -> list:
         except InputError as err:
             raise w.error(key, str(err)) from None
     return forces
+
+
+# --- joints ------------------------------------------------------------------------------------------
+
+def _joints(w, data, body_names) -> list:
+    from .model.joints import Pin, Slider
+
+    joints = []
+    for name, t in _items(w, data, "joints"):
+        key = f"joints.{name}"
+        kind = _text(w, t, "kind", key, choices=JOINT_KINDS)
+        _check_keys(w, t, JOINT_KEYS[kind], key)
+        body = _lookup(w, body_names, t.get("body_a"), f"{key}.body_a", "body")
+        ends = {"body_a": body, "point_a": _vector(w, t, "point_a", key, 2, [0.0, 0.0]),
+                "body_b": _other_body(w, t, key, body, body_names),
+                "point_b": _vector(w, t, "point_b", key, 2, [0.0, 0.0])}
+        if kind == "pin":
+            joints.append(Pin(**ends, name=name))
+            continue
+        axis = _vector(w, t, "axis", key, 2)
+        if not math.hypot(*axis) > 0.0:
+            raise w.error(f"{key}.axis", f"must be a non-zero direction, got {list(axis)}")
+        joints.append(Slider(**ends, axis=axis, angle=math.radians(_number(w, t, "angle_deg", key, 0.0)), name=name))
+    return joints
+
+
+def _check_joints_hold(w, scene, q0) -> None:
+    """Every joint holds at the initial state (to the overlap tolerance): the run keeps it there."""
+    from .model.joints import ROWS_PER_JOINT, joint_violation
+
+    if not scene.joints:
+        return
+    violation = joint_violation(scene.joints, len(scene.bodies), q0)
+    tol = OVERLAP_TOLERANCE * max(1.0, float(np.max(np.abs(q0))))
+    for i, joint in enumerate(scene.joints):
+        worst = float(np.max(np.abs(violation[ROWS_PER_JOINT * i: ROWS_PER_JOINT * (i + 1)])))
+        if not worst <= tol:
+            raise w.error("initial", f"joint {joint.name!r} does not hold at the initial state (off by {worst:.6g}, "
+                                     f"tolerance {tol:.3g}): place its points together")
 
 
 # --- initial state, overlap -----------------------------------------------------------------------
@@ -749,20 +811,23 @@ def parse_scene(data: dict, source: str = "<scene>") -> SceneFile:
     contacts += scene_collisions.found_contacts(w, data, bodies, shapes, lines, segments, contacts)
     forces = _forces(w, data, body_names)
     driven = _driven_bodies(w, data, body_names)
+    joints = _joints(w, data, body_names)
     try:
         with np.errstate(all="ignore"):
-            scene = make_scene(bodies, contacts, gravity, forces, driven)
+            scene = make_scene(bodies, contacts, gravity, forces, driven, joints)
     except InputError as err:
         raise w.error("", str(err)) from None
     if not np.all(np.isfinite(scene.weight)):
         raise w.error("gravity", "the weight m g of a body overflows: masses or gravity far too large")
     q0, v0 = _initial(w, data, body_names)
     _check_overlap(w, scene, q0, v0)
+    _check_joints_hold(w, scene, q0)
     contact_names = [c.name for c in contacts]
     method, t_end, options, stop, save_every = _simulation(w, data, contact_names)
     return SceneFile(scene, q0, v0, t_end, method, options, stop, body_names, contact_names, list(lines),
                      [f.name for f in forces], shapes, lines, data, source,
-                     title=str(data.get("title", "")), segments=segments, save_every=save_every)
+                     title=str(data.get("title", "")), segments=segments, save_every=save_every,
+                     joint_names=[j.name for j in joints])
 
 
 # --- running ----------------------------------------------------------------------------------------

@@ -37,7 +37,7 @@ def modes(summary, contact):
 def test_every_shipped_scene_has_a_test():
     tested = {"bouncing_ball", "block_on_incline", "pushed_block", "disk_on_incline", "belt_oscillator",
               "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod", "ball_off_table",
-              "box_off_table"}
+              "box_off_table", "pendulum_wall"}
     assert {p.stem for p in SCENES.glob("*.toml")} == tested
 
 
@@ -53,6 +53,19 @@ def test_box_off_table_pivots_where_the_moment_of_friction_is_no_longer_balanced
     t_pivot = (v0 - math.sqrt(v0 * v0 - 2 * a * (-mu_d * height / 2 - x0))) / a
     assert s["phases"]["block.v0/table.side+"][0]["t_end"] == pytest.approx(t_pivot, abs=3 * H)
     assert c["block.y"][-1] < 0.5  # off the table (its top at 0.8 m)
+
+
+def test_pendulum_striking_a_wall_rebounds_to_the_closed_form_angle(tmp_path):
+    """Released horizontal about its pin, the rod strikes the wall at the bottom: ω⁺ = −e ω⁻ and
+    it rises to acos(1 − e²) from the vertical (first order in h: 4.3e-4 relative at 1e-3)."""
+    s, c = run(tmp_path, "pendulum_wall")
+    (impact,) = s["impacts"]
+    assert impact["contact"] == "tip"
+    assert impact["v_after"]["rod"][2] / impact["v_before"]["rod"][2] == pytest.approx(-0.5, abs=1e-4)
+    after = c["t"] > impact["t"]
+    assert np.max(c["rod.theta"][after]) + math.pi / 2 == pytest.approx(math.acos(0.75), rel=1e-3)
+    bottom = np.argmin(np.abs(c["rod.theta"][~after] + math.pi / 2))
+    assert c["pivot.Fy"][bottom] == pytest.approx(2.5 * 9.81, rel=2e-2)  # m l ω² + m g at the bottom
 
 
 def test_bouncing_ball_impact_times(tmp_path):

@@ -203,3 +203,15 @@ def test_segments_are_drawn_end_to_end_and_their_contact_frames_follow_the_featu
     assert any(np.array_equal(np.column_stack([ln.get_xdata(), ln.get_ydata()]), [[-1.0, 0.0], [0.0, 0.0]])
                for ln in ax.lines)
     anim._draw_was_started = True  # drawn by hand: no "deleted without rendering" warning
+
+
+def test_a_pin_is_drawn_as_a_ring_at_its_point_moving_with_its_body():
+    sf = load_scene(SCENES / "pendulum_wall.toml", ["simulation.t_end=0.3", "simulation.h=1e-3"])
+    run = simulate_scene(sf)
+    anim = build_animation(run, frames=3, dpi=40)
+    ax = anim._fig.axes[0]
+    anim._func(2)
+    ring = next(ln for ln in ax.lines if ln.get_marker() == "o" and ln.get_markerfacecolor() == "white")
+    world = ax.transData.inverted().transform(ring.get_transform().transform(np.column_stack(ring.get_data())))
+    np.testing.assert_allclose(world[0], [0.0, 0.0], atol=1e-12)  # the pivot stays at the world origin
+    anim._draw_was_started = True

@@ -41,6 +41,9 @@ def check_driven(method: str, scene) -> None:
         raise InputError(f"method {method!r} does not handle driven obstacles or bodies ({driven[0]} moves by a "
                          f"prescribed motion): it lacks their time-dependent gap and velocity; use "
                          f"{', '.join(DRIVEN_METHODS)}")
+# The methods that take bilateral joints (model/joints.py); the driver refuses a jointed scene for
+# the others, naming a joint.
+HANDLES_JOINTS = ("moreau-jean",)
 
 
 def supported_contacts(method: str) -> tuple[str, ...]:
@@ -72,6 +75,6 @@ def check_output_size(samples: float, scene, knob: str = "save_every or a shorte
     return needed
 
 
-__all__ = ["METHODS", "DRIVEN_METHODS", "check_driven", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_classes",
-           "sample_bytes",
+__all__ = ["METHODS", "DRIVEN_METHODS", "check_driven", "HANDLES_JOINTS", "MAX_OUTPUT_BYTES", "check_output_size",
+           "integrator_classes", "sample_bytes",
            "supported_contacts"]

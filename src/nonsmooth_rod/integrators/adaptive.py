@@ -93,7 +93,7 @@ def _out_arrays(n_dof: int, nc: int, steps: int):
     return (np.zeros((rows + 1, n_dof)), np.zeros((rows + 1, n_dof)), np.zeros((rows, nc)), np.zeros((rows, nc)),
             np.zeros((rows, nc)), np.zeros((rows, nc), dtype=np.int64), np.zeros(4 * nc * steps + 4),
             np.zeros(4 * nc * steps + 4, dtype=np.int64), np.zeros(4 * nc * steps + 4, dtype=np.int64),
-            np.zeros(loop.N_COUNTERS, dtype=np.int64))
+            np.zeros(loop.N_COUNTERS, dtype=np.int64), np.zeros((rows, 0)))  # no joints (refused with tol)
 
 
 class Stepper:

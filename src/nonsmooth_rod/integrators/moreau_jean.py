@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import _jit
 from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
+from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
@@ -35,6 +36,7 @@ from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
 from ..validation import Choice, Flag, InputError, Number, Text, check_options, option, require_positive, require_state
 from . import moreau_jean_loop as loop
+from .joint_step import work_size
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
@@ -99,15 +101,18 @@ def loop_kernels(compiled: bool):
     return SimpleNamespace(**{name: interpreted(getattr(loop, name)) for name in _ENTRY_POINTS})
 
 
-def _model_and_work(packed, resume: ResumeState | None, driven_origin=None):
-    """The model and work tuples of moreau_jean_loop; the contact memory from `resume`."""
+def _model_and_work(packed, resume: ResumeState | None, driven_origin=None, joints=None):
+    """The model and work tuples of moreau_jean_loop; the contact memory from `resume`; `joints`
+    the scene's joint table (model.joints.pack_joints; None: no joints)."""
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
+    if joints is None:
+        joints = pack_joints((), n_dof // 3)
     model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
              packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
-             packed.pair_keys, packed.pair_contact) + _drive_slots(packed, driven_origin)
+             packed.pair_keys, packed.pair_contact) + _drive_slots(packed, driven_origin) + (joints,)
     work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
             np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-            np.zeros(n_dof), np.zeros(nc, dtype=np.int64))
+            np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
     if resume is not None:
         work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
             resume.was_closed, resume.grazing, resume.slip_sign
@@ -245,10 +250,10 @@ class MoreauJean:
         grid = Grid.of(opts.h, t0, t_end, resume)
         packed = pack_scene(scene)
         origin, v0 = driven_start(packed, q0, v0, float(grid.time(grid.first)))
-        model, work = _model_and_work(packed, resume, origin)
-        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)))
+        model, work = _model_and_work(packed, resume, origin, pack_joints(scene.joints, len(scene.bodies)))
+        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
-        collector = Collector(grid, scene.n_dof, len(names), save_every, resume)
+        collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         params, iparams = self._parameters(scene, grid, names)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
         engine = Engine(bool(opts.fast and _jit.ENABLED),
@@ -267,6 +272,10 @@ class MoreauJean:
         """The error-controlled run (integrators/adaptive.py) on this integrator's loop and kernels."""
         from .adaptive import run_adaptive
 
+        if scene.joints or scene.driven_things():
+            what = f"joint {scene.joints[0].name!r}" if scene.joints else scene.driven_things()[0] + " (driven)"
+            raise InputError(f"tol: error control does not handle joints or driven obstacles and bodies yet ({what}); "
+                             "give a fixed step h instead")
         packed = pack_scene(scene)
         model, work = _model_and_work(packed, resume)
         params, iparams = self._parameters(scene, Grid.of(self.options.h, t0, t_end, None), names)
@@ -478,11 +487,19 @@ class MoreauJean:
                      steps_at_rest=int(counters[loop.K_REPEATED]))
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, events,
                                   impacts, phases, steps=n_done, cpu_time_s=cpu, stats=stats)
+        result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
         result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
         return result
+
+
+def joint_forces(joints, impulses_over_h) -> dict:
+    """{joint name: {reaction: samples}}: a pin's world force (Fx, Fy) on body_a, a slider's force
+    F along its line's normal and torque M on body_a (N, N·m: the step's impulses / h)."""
+    return {joint.name: {what: impulses_over_h[:, ROWS_PER_JOINT * i + r]
+                         for r, what in enumerate(REACTION_NAMES[joint.kind])} for i, joint in enumerate(joints)}
 
 
 _KERNEL_FAILURES = {1: "no valid solution of the step problem (secondary ray)",

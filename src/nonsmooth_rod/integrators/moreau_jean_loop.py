@@ -38,10 +38,13 @@ def _inlined(function):
     return numba.njit(cache=True, inline="always")(function)
 from ..model.contact_kernels import C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_SURFACE_VELOCITY, obstacle_velocity
 from ..model.forces import accumulate_forces
+from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A,
                              contact_kinematics, drive_contacts, local_dot)
 from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
+from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
+                         project_positions)
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
                                        two_coefficient_by_group, two_coefficient_into)
 
@@ -92,6 +95,13 @@ SCRATCH_SOLVER_CONTACTS = 16
 # motions (table, times, values), their evaluation at the current step (NOW_* columns), the driven
 # bodies (body, motion) and each one's placement the motion displaces (origin: q0 − d(t0)).
 M_MOTIONS, M_MOTION_TIMES, M_MOTION_VALUES, M_MOTION_NOW, M_DRIVEN, M_DRIVEN_ORIGIN = range(12, 18)
+# Slots of the joints (joint_step.py) in the model, work and out tuples, after the others (one
+# array each: every array of a tuple costs reference counting in every step, joints or not).
+# model: the joint table (model/joints.pack_joints); work: the joints' buffer (joint_step.joint_views).
+M_JOINTS = 18
+WORK_JOINTS = 11
+# out: each step's joint impulses (rows × 2 per joint).
+O_JOINT_IMPULSE = 10
 
 
 @_inlined
@@ -189,6 +199,8 @@ def begin_step(params, qk, vk, f, model, work):
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
         v_free[d] = vk[d] + h * a_free[d]
+    if model[M_JOINTS].shape[0] > 0:  # (arrays, not the tuples: a call with them costs every step)
+        _joints_begin(qk, minv, model[M_JOINTS], work[WORK_JOINTS], v_free, a_free)
     broad = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
     if broad:
         broad_phase(h, qk, vk, model[8], model[9], model[10], model[11], was_closed, candidate)
@@ -368,6 +380,8 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             # a closing contact slides the way it arrives
             u_t = relative_slip_velocity(table, hn, ht, index, i, vk, True)
             guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
+    if model[M_JOINTS].shape[0] > 0:
+        _joints_delassus(na, active, hn, ht, index, minv, model[M_JOINTS], work[WORK_JOINTS], W)
 
 
 @jit
@@ -428,10 +442,15 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
                 for d in range(3):
                     v_next[3 * body + d] += minv[3 * body + d] * (hn[i, 3 * side + d] * p[2 * a]
                                                                   + ht[i, 3 * side + d] * p[2 * a + 1])
+    joints = model[M_JOINTS].shape[0] > 0
+    if joints:
+        _joints_finish(v_next, minv, model[M_JOINTS], work[WORK_JOINTS], out[O_JOINT_IMPULSE][k])
     finite = True
     for d in range(qk.shape[0]):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
+    if joints and finite:
+        _joints_project(q[k + 1], na, states, active, hn, ht, index, minv, model[M_JOINTS], work[WORK_JOINTS])
     status = RUN_OK
     broad, candidate = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS, work[10]  # as begin_step's broad phase
     for i in range(table.shape[0]):
@@ -465,6 +484,50 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     if not finite:
         return RUN_NONFINITE
     return status
+
+
+@jit
+def _joint_state(minv, table, buffer):
+    """(dofs, slot, J, C, A⁺, W_c, λ_free) of the joints: the jointed dofs and the buffer's views."""
+    n_dof = minv.shape[0]
+    dofs, slot = jointed_dofs(table, n_dof)
+    J, C, A_pinv, WC, free = joint_views(buffer, ROWS_PER_JOINT * table.shape[0], n_dof, dofs.shape[0])
+    return dofs, slot, J, C, A_pinv, WC, free
+
+
+@jit
+def _joints_begin(qk, minv, table, buffer, v_free, a_free):
+    """The joints at q_k (J, A⁺, W_c) and the free velocity and acceleration projected onto them."""
+    dofs, _, J, C, A_pinv, WC, free = _joint_state(minv, table, buffer)
+    joint_operators(qk, minv, table, dofs, J, C, A_pinv, WC)
+    project_onto_joints(v_free, minv, J, A_pinv, free)
+    project_onto_joints(a_free, minv, J, A_pinv, np.empty(J.shape[0]))
+
+
+@jit
+def _joints_delassus(na, active, hn, ht, index, minv, table, buffer, W):
+    """W = H W_c Hᵀ over the active contacts: the contacts' Delassus matrix with the joints."""
+    _, slot, _, _, _, WC, _ = _joint_state(minv, table, buffer)
+    constrained_delassus(na, active, hn, ht, index, minv, slot, WC, W)
+
+
+@jit
+def _joints_finish(v_next, minv, table, buffer, impulse):
+    """v_{k+1} projected onto the joints (J v_{k+1} = 0) and the step's joint impulses recorded."""
+    _, _, J, _, A_pinv, _, free = _joint_state(minv, table, buffer)
+    project_onto_joints(v_next, minv, J, A_pinv, impulse)
+    for r in range(impulse.shape[0]):
+        impulse[r] += free[r]
+
+
+@jit
+def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buffer):
+    """q_{k+1} projected back onto the joints' positions C(q) = 0 (their drift stays round-off),
+    the contacts that held this step kept where they are."""
+    _, slot, J, C, _, _, _ = _joint_state(minv, table, buffer)
+    held, held_bodies = np.empty((2 * na, 6)), np.empty((2 * na, 2), dtype=np.int64)
+    n_held = held_contact_rows(na, active, states, hn, ht, index, slot, held, held_bodies)
+    project_positions(q_next, minv, table, J, C, held, held_bodies, n_held)
 
 
 @jit
@@ -522,7 +585,8 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, p_norma
     functions take only the arrays they use: each array of a tuple passed in costs ~10 ns of
     reference counting per step.)"""
     m = 2 * na
-    sparse = solver_code == SOLVER_PGS  # pgs sweeps the block-sparse W; lemke, enum need it dense
+    # pgs sweeps the block-sparse W; lemke, enum need it dense, and so do joints (W_c couples a cluster)
+    sparse = solver_code == SOLVER_PGS and model[M_JOINTS].shape[0] == 0
     W = _dense_matrix(scratch, m, sparse)
     floats = scratch[S_FLOATS]
     q_step, at = carve(floats, 0, m)
@@ -721,6 +785,7 @@ def _repeat_period(k, k_end, period, out, work, memory, before):
         out[3][r, :] = out[3][r - period]
         out[4][r, :] = out[4][r - period]
         out[5][r, :] = out[5][r - period]
+        out[O_JOINT_IMPULSE][r, :] = out[O_JOINT_IMPULSE][r - period]
     for c in range(len(REPEATED_COUNTERS)):
         added = 0
         for j in range(k + 1 - period, k + 1):  # each repeated step adds what its original added

@@ -72,8 +72,8 @@ class ResumeState:
         rows = {name: np.asarray(d[name], dtype=np.int64 if name in _INT_ARRAYS else float) for name in _ARRAYS}
         for name in ("q", "v"):
             rows[name] = rows[name].reshape(-1, n_dof)
-        for name in RECORDS:
-            rows[name] = rows[name].reshape(-1, n_contacts)
+        for name in RECORDS:  # one row per step before the end state (a scene may have no contacts)
+            rows[name] = rows[name].reshape(rows["q"].shape[0] - 1, n_contacts)
         return cls(float(d["origin"]), int(d["step"]), float(d["h"]), bool(d["on_grid"]), float(d["last_h"]),
                    **rows)
 
@@ -127,14 +127,14 @@ class Window:
 
     Row r holds the state at step k_base + r and the records of the step leaving it."""
 
-    def __init__(self, n_dof: int, n_contacts: int, chunk: int):
+    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0):
         rows = HISTORY + chunk
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
         self.out = (np.empty((rows + 1, n_dof)), np.empty((rows + 1, n_dof)), np.zeros((rows, n_contacts)),
                     np.zeros((rows, n_contacts)), np.zeros((rows, n_contacts)),
                     np.zeros((rows, n_contacts), dtype=np.int64), np.zeros(capacity),
                     np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
-                    np.zeros(loop.N_COUNTERS, dtype=np.int64))
+                    np.zeros(loop.N_COUNTERS, dtype=np.int64), np.zeros((rows, joint_rows)))
         self.rows, self.k_base, self.r = rows, 0, 0
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
@@ -158,7 +158,7 @@ class Window:
         lo = self.r - keep
         for a in self.out[:2]:
             a[: keep + 1] = a[lo: self.r + 1]
-        for a in self.out[2:6]:
+        for a in self.out[2:6] + (self.out[loop.O_JOINT_IMPULSE],):
             a[:keep] = a[lo: self.r]
         self.k_base += lo
         self.r = keep
@@ -199,8 +199,9 @@ class Collector:
     """The samples, state runs, boundary rows and impact rows of a run, taken window by window."""
 
     def __init__(self, grid: Grid, n_dof: int, n_contacts: int, save_every: float | None,
-                 resume: ResumeState | None):
+                 resume: ResumeState | None, joint_rows: int = 0):
         n = count_kept(grid, save_every)
+        self.joint_force = np.empty((n, joint_rows))  # each kept step's joint impulses / h
         self.grid, self.save_every, self.resume = grid, save_every, resume
         self.t, self.q, self.v, self.a = np.empty(n), np.empty((n, n_dof)), np.empty((n, n_dof)), np.empty((n, n_dof))
         self.N, self.T = np.empty((n, n_contacts)), np.empty((n, n_contacts))
@@ -245,6 +246,7 @@ class Collector:
         self.a[m] = np.where(has_step, (out[1][rows] - out[1][before]) / h, np.nan)
         self.N[m] = np.where(has_step, out[2][before] / h, 0.0)
         self.T[m] = np.where(has_step, out[3][before] / h, 0.0)
+        self.joint_force[m] = np.where(has_step, out[loop.O_JOINT_IMPULSE][before] / h, 0.0)
         self.codes[m] = out[5][before]  # the first sample of a fresh run: the mode of its first step
         self.n += ks.size
 

@@ -1,4 +1,4 @@
-"""Applied forces as data: springs, dampers, constant, ramped and tabulated forces.
+"""Applied forces as data: springs, dampers, torsion springs, constant, ramped and tabulated forces.
 
 Each force is a small frozen dataclass that validates its fields, and `generalised_force(t, q, v,
 n_dof)` gives its contribution to the scene's generalised force (forces on the centres of mass,
@@ -23,6 +23,7 @@ from ..validation import InputError, quoted, require_finite, require_nonnegative
 
 # Force kinds of the packed table.
 FORCE_SPRING, FORCE_CONSTANT, FORCE_RAMPED, FORCE_TABULATED = 0, 1, 2, 3
+FORCE_TORSION = 4
 # Float columns of the packed force table.
 (F_PA_X, F_PA_Y, F_PB_X, F_PB_Y, F_STIFFNESS, F_REST_LENGTH, F_DAMPING, F_FX, F_FY, F_TORQUE,
  F_T_START, F_T_FULL) = range(12)
@@ -169,7 +170,37 @@ class TabulatedForce(_Force):
         object.__setattr__(self, "torques", tuple(torques.tolist()))
 
 
-FORCE_TYPES = (Spring, ConstantForce, RampedForce, TabulatedForce)
+@dataclass(frozen=True)
+class TorsionSpring(_Force):
+    """A torsional spring-damper between two bodies, or a body and the world (body_b None).
+
+    Torque −k (θ_a − θ_b − rest_angle) − c (ω_a − ω_b) on body_a, the opposite on body_b (θ_b, ω_b
+    zero for the world). rest_angle in radians."""
+
+    body_a: int
+    body_b: int | None = None
+    stiffness: float = 0.0
+    rest_angle: float = 0.0
+    damping: float = 0.0
+    name: str = "torsion-spring"
+
+    def __post_init__(self):
+        _require_body(self.name, "body_a", self.body_a)
+        if self.body_b is not None:
+            _require_body(self.name, "body_b", self.body_b)
+            if self.body_b == self.body_a:
+                raise InputError(f"{self.name}: body_b must differ from body_a (or be None for the world)")
+        require_nonnegative(f"{self.name} stiffness", self.stiffness)
+        require_finite(f"{self.name} rest_angle", self.rest_angle)
+        require_nonnegative(f"{self.name} damping", self.damping)
+
+
+def Torque(body: int, torque: float = 0.0, name: str = "torque") -> ConstantForce:
+    """A constant torque on a body: a ConstantForce without force."""
+    return ConstantForce(body, (0.0, 0.0), torque, (0.0, 0.0), name=name)
+
+
+FORCE_TYPES = (Spring, ConstantForce, RampedForce, TabulatedForce, TorsionSpring)
 
 
 def pack_forces(forces) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -193,6 +224,10 @@ def pack_forces(forces) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
             row[[F_FX, F_FY]], row[F_TORQUE] = force.force, force.torque
             if isinstance(force, RampedForce):
                 row[F_T_START], row[F_T_FULL] = force.t_start, force.t_full
+        elif isinstance(force, TorsionSpring):
+            ix[FI_KIND], ix[FI_BODY_A] = FORCE_TORSION, force.body_a
+            ix[FI_BODY_B] = -1 if force.body_b is None else force.body_b
+            row[[F_STIFFNESS, F_REST_LENGTH, F_DAMPING]] = force.stiffness, force.rest_angle, force.damping
         elif isinstance(force, TabulatedForce):
             ix[FI_KIND], ix[FI_BODY_A] = FORCE_TABULATED, force.body
             row[[F_PA_X, F_PA_Y]] = force.point
@@ -200,8 +235,8 @@ def pack_forces(forces) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
             times.extend(force.times)
             values.extend((fx, fy, tz) for (fx, fy), tz in zip(force.forces, force.torques))
         else:
-            raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce or "
-                             f"TabulatedForce, got {type(force).__name__}")
+            raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce, "
+                             f"TabulatedForce or TorsionSpring, got {type(force).__name__}")
     return (table, index, np.array(times, dtype=float).reshape(-1),
             np.array(values, dtype=float).reshape(-1, 3))
 
@@ -247,6 +282,20 @@ def _spring(q, v, row, body_a, body_b, f):
 
 
 @jit
+def _torsion(q, v, row, body_a, body_b, f):
+    """−k (θ_a − θ_b − θ_rest) − c (ω_a − ω_b) on body_a, its opposite on body_b (unless the world)."""
+    ja = 3 * body_a + 2
+    angle, rate = q[ja] - row[F_REST_LENGTH], v[ja]  # F_REST_LENGTH holds the rest angle
+    if body_b >= 0:
+        angle -= q[3 * body_b + 2]
+        rate -= v[3 * body_b + 2]
+    torque = -row[F_STIFFNESS] * angle - row[F_DAMPING] * rate
+    f[ja] += torque
+    if body_b >= 0:
+        f[3 * body_b + 2] -= torque
+
+
+@jit
 def _tabulated(t, times, values, start, rows):
     """Linear interpolation of the rows [start, start + rows) of (times, values) at t."""
     last = start + rows - 1
@@ -276,6 +325,9 @@ def accumulate_forces(t, q, v, table, index, times, values, f):
         if kind == FORCE_SPRING:
             _spring(q, v, row, body, index[i, FI_BODY_B], f)
             continue
+        if kind == FORCE_TORSION:
+            _torsion(q, v, row, body, index[i, FI_BODY_B], f)
+            continue
         scale = 1.0
         fx, fy, torque = row[F_FX], row[F_FY], row[F_TORQUE]
         if kind == FORCE_RAMPED:
@@ -286,5 +338,6 @@ def accumulate_forces(t, q, v, table, index, times, values, f):
                         scale * torque)
 
 
-__all__ = ["Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "FORCE_TYPES",
+__all__ = ["Spring", "Damper", "ConstantForce", "RampedForce", "TabulatedForce", "TorsionSpring", "Torque",
+           "FORCE_TYPES",
            "pack_forces", "accumulate_forces"]

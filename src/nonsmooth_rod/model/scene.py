@@ -36,6 +36,7 @@ class Scene:
     applied_force: AppliedForce | None = None
     forces: Sequence = ()  # model.forces: Spring, Damper, ConstantForce, RampedForce, TabulatedForce
     driven: Sequence = ()  # model.motion.DrivenBody: bodies whose placement is prescribed in time
+    joints: Sequence = ()  # model.joints: Pin, Slider
 
     def __post_init__(self):
         self.gravity_vector = gravity_vector(self.gravity)
@@ -48,10 +49,12 @@ class Scene:
         self.forces = list(self.forces)
         for i, force in enumerate(self.forces):
             if not isinstance(force, FORCE_TYPES):
-                raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce or "
-                                 f"TabulatedForce, got {type(force).__name__}")
+                raise InputError(f"forces[{i}] must be a Spring, Damper, ConstantForce, RampedForce, "
+                                 f"TabulatedForce or TorsionSpring, got {type(force).__name__}")
+        self.joints = list(self.joints)
         self._check_references()
         self._check_driven()
+        self._check_joints()
         self.mass_diagonal = np.concatenate([b.mass_matrix_diagonal for b in self.bodies])
         self.inverse_mass_diagonal = 1.0 / self.mass_diagonal
         self.weight = np.zeros(self.n_dof)
@@ -113,6 +116,23 @@ class Scene:
 
         motions = [getattr(c, "obstacle_motion", None) for c in self.contacts] + [d.motion for d in self.driven]
         return any(isinstance(m, Prescribed) for m in motions)
+    def _check_joints(self) -> None:
+        """Joints are Pin or Slider on bodies that exist, with unique names."""
+        from .joints import JOINT_TYPES
+
+        seen = set()
+        for i, joint in enumerate(self.joints):
+            if not isinstance(joint, JOINT_TYPES):
+                raise InputError(f"joints[{i}] must be a Pin or a Slider, got {type(joint).__name__}")
+            require_name(f"joints[{i}] name", joint.name)
+            if joint.name in seen:
+                raise InputError(f"two joints are named {joint.name!r}: joint names must be unique")
+            seen.add(joint.name)
+            for attr in ("body_a", "body_b"):
+                body = getattr(joint, attr)
+                if body is not None and body >= len(self.bodies):
+                    raise InputError(f"joint {joint.name!r} {attr} refers to body {body}, but the scene has "
+                                     f"{len(self.bodies)} bodies")
 
     def forces_vary_in_time(self) -> bool:
         """True when the applied force may change while the state does not (a Python

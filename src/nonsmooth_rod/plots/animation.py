@@ -4,7 +4,8 @@ How a body is drawn: from its `shape` in the scene file (disk/ball: a circle wit
 the turn; rectangle; rod: a segment; rod-with-balls: a segment with a ball at each end, the centre
 of mass in the middle). A body without a shape is drawn from its contacts: a circle for each disk
 contact (offset, radius), a dot for each point contact, joined by their convex hull (or a segment),
-and the centre of mass as a cross. Contact forces are arrows N n + T t at the contact point.
+and the centre of mass as a cross. Contact forces are arrows N n + T t at the contact point. Joints:
+a ring at each pin's points, a square at each slider's, on the bodies they join.
 
     write_animation(result, "out/")          -> animation.gif (+ animation.mp4 if ffmpeg exists)
     animate(result)                          -> inline HTML animation for notebooks
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..io import atomic_path
 from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge, VertexOnEdge
+from ..model.joints import Pin
 from ..validation import InputError
 
 
@@ -80,8 +82,20 @@ def body_outline(sf, body: int) -> list:
     return _outline_from_contacts(sf, body)
 
 
+def joint_points(scene, body: int) -> list:
+    """(kind, point) in `body`'s frame of every joint it takes part in: ("pin" | "slider", (x, y))."""
+    points = []
+    for joint in getattr(scene, "joints", ()):
+        kind = "pin" if isinstance(joint, Pin) else "slider"
+        if joint.body_a == body:
+            points.append((kind, tuple(joint.point_a)))
+        if joint.body_b == body:
+            points.append((kind, tuple(joint.point_b)))
+    return points
+
+
 def _outline_from_contacts(sf, body: int) -> list:
-    parts = _contact_parts(sf.scene, body)
+    parts = _contact_parts(sf.scene, body) + [(point, 0.0) for _, point in joint_points(sf.scene, body)]
     prims = [("circle", off, r) if r > 0 else ("dot", off) for off, r in parts]
     points = np.array([off for off, _ in parts] + [(0.0, 0.0)])
     hull = _hull(points)
@@ -191,6 +205,11 @@ def _make_artists(ax, sf) -> list:
             else:
                 art = Line2D([prim[1][0]], [prim[1][1]], marker="x" if prim[0] == "cross" else "o", color="k", ms=5)
             (ax.add_patch if hasattr(art, "set_facecolor") else ax.add_line)(art)
+            artists.append(art)
+        for kind, point in joint_points(sf.scene, i):  # a pin: a ring; a slider: a square
+            art = Line2D([point[0]], [point[1]], marker="o" if kind == "pin" else "s", mfc="white", mec="k", ms=6,
+                         zorder=6)
+            ax.add_line(art)
             artists.append(art)
         bodies.append(artists)
     return bodies

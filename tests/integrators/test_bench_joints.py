@@ -1,0 +1,20 @@
+"""benchmarks/bench_joints.py --quick: a double pendulum's joints stay at round-off (the full run,
+10⁶ steps, is the issue's check: docs/joints.md)."""
+import importlib.util
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_joints", ROOT / "benchmarks" / "bench_joints.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_quick_run_keeps_the_joints_at_round_off(capsys):
+    assert _bench().main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    drift = float(out.split("largest joint violation over ")[1].split(": ")[1].split(" m")[0])
+    assert drift < 1e-13  # round-off of coordinates of order 1 m, far inside the 1e-9 limit
