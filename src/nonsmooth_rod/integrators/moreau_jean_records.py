@@ -258,6 +258,7 @@ class Collector:
             first = self.n
             self.t[first], self.q[first], self.v[first] = self.grid.time(ks[:1])[0], out[0][0], out[1][0]
             self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, out[5][0]
+            self.joint_force[first] = 0.0
             self.n, ks, r0, n = first + 1, ks[1:], 1, n - 1
         rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(self.n, self.n + n)
         h = self.grid.h if not (self.grid.h_last or self.resume is not None) else self.step_size(ks)[:, None]
@@ -265,6 +266,7 @@ class Collector:
         np.divide(out[1][rows] - out[1][before], h, out=self.a[m])
         np.divide(out[2][before], h, out=self.N[m])
         np.divide(out[3][before], h, out=self.T[m])
+        np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
         self.codes[m] = out[5][before]
         self.n += n
 
