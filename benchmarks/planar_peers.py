@@ -26,8 +26,11 @@ of cost only.
 from __future__ import annotations
 
 import math
-import statistics
-import time
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # benchmarks/ for other_engines
+from other_engines import _median_step_us  # noqa: E402  (one timing loop for every peer)
 
 PEER_SETTINGS = {
     "mujoco": "planar (slide x, slide z, hinge y); Newton solver, 100 iterations, tol 1e-8, pyramidal cone, "
@@ -36,17 +39,6 @@ PEER_SETTINGS = {
     "pymunk10": "Chipmunk2D, space.iterations = 10 (default), friction sqrt(mu) per shape",
     "pymunk100": "Chipmunk2D, space.iterations = 100",
 }
-
-
-def _median_step_us(step, reset, steps: int, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        reset()
-        t0 = time.process_time()
-        for _ in range(steps):
-            step()
-        times.append((time.process_time() - t0) / steps * 1e6)
-    return statistics.median(times)
 
 
 def mujoco_planar_step_us(scene, h, steps, repeats):

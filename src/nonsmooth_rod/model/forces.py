@@ -47,6 +47,18 @@ def _require_point(owner: str, field_name: str, point) -> tuple[float, float]:
     return (require_finite(f"{owner} {field_name}", x), require_finite(f"{owner} {field_name}", y))
 
 
+def check_two_ends(item, world: str) -> None:
+    """body_a, point_a and body_b (None: the world), point_b of a spring, damper or joint, checked;
+    the points stored as float pairs. `world`: what body_b = None means, for the message."""
+    _require_body(item.name, "body_a", item.body_a)
+    if item.body_b is not None:
+        _require_body(item.name, "body_b", item.body_b)
+        if item.body_b == item.body_a:
+            raise InputError(f"{item.name}: body_b must differ from body_a (or be None for {world})")
+    object.__setattr__(item, "point_a", _require_point(item.name, "point_a", item.point_a))
+    object.__setattr__(item, "point_b", _require_point(item.name, "point_b", item.point_b))
+
+
 class _Force:
     """What every force shares: the Python evaluation through the packed kernel."""
 
@@ -79,13 +91,7 @@ class Spring(_Force):
     name: str = "spring"
 
     def __post_init__(self):
-        _require_body(self.name, "body_a", self.body_a)
-        if self.body_b is not None:
-            _require_body(self.name, "body_b", self.body_b)
-            if self.body_b == self.body_a:
-                raise InputError(f"{self.name}: body_b must differ from body_a (or be None for a world point)")
-        object.__setattr__(self, "point_a", _require_point(self.name, "point_a", self.point_a))
-        object.__setattr__(self, "point_b", _require_point(self.name, "point_b", self.point_b))
+        check_two_ends(self, "a world point")
         require_nonnegative(f"{self.name} stiffness", self.stiffness)
         require_nonnegative(f"{self.name} rest_length", self.rest_length)
         require_nonnegative(f"{self.name} damping", self.damping)

@@ -25,7 +25,7 @@ import numpy as np
 from .._jit import jit
 from ..solvers._common import interpreted
 from ..validation import InputError, quoted, require_finite
-from .forces import _require_body, _require_point
+from .forces import _require_point, check_two_ends
 
 JOINT_PIN, JOINT_SLIDER = 0, 1
 ROWS_PER_JOINT = 2
@@ -35,16 +35,6 @@ J_PA_X, J_PA_Y, J_PB_X, J_PB_Y, J_AXIS_X, J_AXIS_Y, J_ANGLE, J_KIND, J_BODY_A, J
 N_JOINT_COLUMNS = 10
 # What each joint's two multipliers are, by kind (trajectory.csv's column suffixes).
 REACTION_NAMES = {JOINT_PIN: ("Fx", "Fy"), JOINT_SLIDER: ("F", "M")}
-
-
-def _check_ends(joint) -> None:
-    _require_body(joint.name, "body_a", joint.body_a)
-    if joint.body_b is not None:
-        _require_body(joint.name, "body_b", joint.body_b)
-        if joint.body_b == joint.body_a:
-            raise InputError(f"{joint.name}: body_b must differ from body_a (or be None to join body_a to the world)")
-    object.__setattr__(joint, "point_a", _require_point(joint.name, "point_a", joint.point_a))
-    object.__setattr__(joint, "point_b", _require_point(joint.name, "point_b", joint.point_b))
 
 
 @dataclass(frozen=True)
@@ -61,7 +51,7 @@ class Pin:
     kind = JOINT_PIN
 
     def __post_init__(self):
-        _check_ends(self)
+        check_two_ends(self, "the world")
 
 
 @dataclass(frozen=True)
@@ -81,7 +71,7 @@ class Slider:
     kind = JOINT_SLIDER
 
     def __post_init__(self):
-        _check_ends(self)
+        check_two_ends(self, "the world")
         ax, ay = _require_point(self.name, "axis", self.axis)
         length = math.hypot(ax, ay)
         if not length > 0.0 or not math.isfinite(length):
