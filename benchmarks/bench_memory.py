@@ -31,7 +31,12 @@ def _status_kb(field: str) -> int:
 
 def _env():
     env = dict(os.environ, MPLBACKEND="Agg")
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), env.get("PYTHONPATH")]))
+    # the package this process imports (the checkout's src/, or where pip installed it): a child that
+    # imported another copy would compile the engine again (numba caches by source file)
+    import nonsmooth_rod
+
+    package_root = str(Path(nonsmooth_rod.__file__).resolve().parents[1])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [package_root, env.get("PYTHONPATH")]))
     return env
 
 

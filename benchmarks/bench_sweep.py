@@ -79,7 +79,10 @@ def cli_map(n: int, jobs: int, plot: bool) -> dict:
                 f"0.5:1.0:{n}", "--jobs", str(jobs), "--out", str(out), "--quiet"] + ([] if plot else ["--no-plot"])
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
-        proc = subprocess.run(argv, env=os.environ | {"PYTHONPATH": str(ROOT / "src")}, capture_output=True, text=True)
+        import nonsmooth_rod  # the copy this process imports: another would compile the engine again
+
+        package_root = str(Path(nonsmooth_rod.__file__).resolve().parents[1])
+        proc = subprocess.run(argv, env=os.environ | {"PYTHONPATH": package_root}, capture_output=True, text=True)
         wall = time.perf_counter() - t0
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         if proc.returncode != 0:

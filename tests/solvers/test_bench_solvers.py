@@ -10,7 +10,10 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_bench_solvers_quick_runs():
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    import nonsmooth_rod
+
+    # the copy this process imports (installed or src/): another copy would compile the kernels again
+    env = dict(os.environ, PYTHONPATH=str(Path(nonsmooth_rod.__file__).resolve().parents[1]))
     result = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "bench_solvers.py"), "--quick"],
                             capture_output=True, text=True, timeout=300, env=env)
     assert result.returncode == 0, result.stderr
