@@ -1,7 +1,7 @@
 """Compile parts of the Moreau–Jean engine into numba's on-disk cache.
 
-`python -m nonsmooth_rod._compile_job [--step]` (the whole-run loop, or the step-wise loop for
-Python force callbacks; every exact solver is compiled into each) and
+`python -m nonsmooth_rod._compile_job` (the loop, which runs whole runs and, one step a call,
+runs with Python force callbacks; every exact solver is compiled into it) and
 `python -m nonsmooth_rod._compile_job --python-step SOLVER` (the step kernels around a Python
 solver) are what a cold run starts in the background (`_jit.compile_in_background`);
 `nonsmooth-rod compile` calls `warm_up`. Each part compiles under its lock and is marked when done.
@@ -13,7 +13,7 @@ import sys
 import time
 
 
-def _tiny_scene(applied_force=None):
+def _tiny_scene():
     """Two balls on a floor touching each other: every contact kind the loop packs."""
     from .model.body import RigidBody
     from .model.contacts import DiskOnDisk, DiskOnLine, Line
@@ -25,19 +25,12 @@ def _tiny_scene(applied_force=None):
     contacts = [DiskOnLine(0, (0.0, 0.0), Line(), 0.05, law, "floor0"),
                 DiskOnLine(1, (0.0, 0.0), Line(), 0.05, law, "floor1"),
                 DiskOnDisk(0, 1, 0.05, 0.05, law=law, name="pair")]
-    return Scene(balls, contacts, applied_force=applied_force)
+    return Scene(balls, contacts)
 
 
-def _no_force(t, q, v):
-    import numpy as np
-
-    return np.zeros(6)
-
-
-def warm_up(solvers=("lemke",), loop: bool = True, step: bool = False) -> float:
-    """Compile the whole-run loop (`loop`) and the step-wise loop for Python force callbacks
-    (`step`) by running a tiny scene with each solver (the first compiles, the others load or are
-    already there); returns the seconds it took."""
+def warm_up(solvers=("lemke",)) -> float:
+    """Compile the loop by running a tiny scene with each solver (the first compiles, the others
+    load or are already there); returns the seconds it took."""
     previous = os.environ.get("NONSMOOTH_ROD_COMPILE")
     os.environ["NONSMOOTH_ROD_COMPILE"] = "wait"  # compile here and now, not in yet another process
     try:
@@ -46,10 +39,7 @@ def warm_up(solvers=("lemke",), loop: bool = True, step: bool = False) -> float:
         start = time.perf_counter()
         q0, v0 = [0.0, 0.05, 0.0, 0.2, 0.05, 0.0], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         for solver in solvers:
-            if loop:
-                simulate(_tiny_scene(), q0, v0, 0.01, method="moreau-jean", h=1e-3, solver=solver)
-            if step:
-                simulate(_tiny_scene(_no_force), q0, v0, 0.01, method="moreau-jean", h=1e-3, solver=solver)
+            simulate(_tiny_scene(), q0, v0, 0.01, method="moreau-jean", h=1e-3, solver=solver)
         return time.perf_counter() - start
     finally:
         if previous is None:
@@ -70,7 +60,6 @@ def warm_up_python_step(solver: str) -> float:
 
 def main(argv=None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
-    step = "--step" in args
     solvers = [a for a in args if not a.startswith("--")]
     if "--python-step" in args:
         os.environ["NONSMOOTH_ROD_COMPILE"] = "wait"
@@ -81,8 +70,8 @@ def main(argv=None) -> int:
         os.nice(5)  # the user's interpreted run goes first on a busy machine
     except (AttributeError, OSError):
         pass
-    seconds = warm_up(loop=not step, step=step)
-    print(f"compiled the {'step-wise' if step else 'whole-run'} Moreau–Jean loop in {seconds:.1f} s", flush=True)
+    seconds = warm_up()
+    print(f"compiled the Moreau–Jean loop in {seconds:.1f} s", flush=True)
     return 0
 
 

@@ -6,16 +6,15 @@ from nonsmooth_rod.cli import main
 
 
 @pytest.mark.skipif(not _jit.ENABLED, reason="numba not installed")
-def test_compile_marks_both_loops_warm_and_records_their_time(tmp_path, monkeypatch, capsys):
+def test_compile_marks_the_loop_warm_and_records_its_time(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(_jit, "_marker", lambda part="engine": tmp_path / f"{part}.marker")
     monkeypatch.setattr(_jit, "_warm", set())
     assert not _jit.engine_is_warm("moreau-jean")
-    assert main(["compile", "--no-step"]) == 0
+    assert main(["compile"]) == 0
     assert "compiled in" in capsys.readouterr().out
-    assert _jit.engine_is_warm("moreau-jean") and not _jit.engine_is_warm("moreau-jean-step")
+    assert _jit.engine_is_warm("moreau-jean")
     assert main(["compile", "--quiet"]) == 0
     assert capsys.readouterr().out == ""
-    assert _jit.engine_is_warm("moreau-jean-step")
     seconds, measured = _jit.compile_estimate_s("moreau-jean")
     assert measured and seconds >= 0.0
 

@@ -9,20 +9,17 @@ def register(subparsers) -> None:
                     "worker of a sweep) load it from the cache instead of compiling. The cache is next to "
                     "the package, or in NUMBA_CACHE_DIR, or in ~/.cache/nonsmooth-rod/numba where the "
                     "package folder is read-only.")
-    p.add_argument("--no-step", action="store_true",
-                   help="compile only the whole-run loop, not the step-wise loop that Python force "
-                        "callbacks use")
     p.add_argument("--quiet", action="store_true", help="print nothing")
     p.set_defaults(handler=cmd_compile)
 
 
-def warm_up(step: bool = True) -> float:
-    """Compile the whole-run loop and (with `step`) the step-wise loop, every exact solver in each;
-    returns the seconds it took."""
+def warm_up() -> float:
+    """Compile the loop (whole runs, and runs with Python force callbacks one step a call), every
+    exact solver in it; returns the seconds it took."""
     from .._compile_job import warm_up as compile_parts
     from ..solvers import EXACT_SOLVERS
 
-    return compile_parts(EXACT_SOLVERS, loop=True, step=step)
+    return compile_parts(EXACT_SOLVERS)
 
 
 def cmd_compile(args) -> int:
@@ -34,8 +31,8 @@ def cmd_compile(args) -> int:
         return 0
     if not args.quiet:
         _jit.set_compile_notifier(lambda message: print(f"nonsmooth-rod: {message}", flush=True))
-        print("compiling the Moreau–Jean loops (every exact solver) into the cache", flush=True)
-    seconds = warm_up(step=not args.no_step)
+        print("compiling the Moreau–Jean loop (every exact solver) into the cache", flush=True)
+    seconds = warm_up()
     if not args.quiet:
         print(f"compiled in {seconds:.1f} s; cache markers in {_jit._marker().parent}")
     return 0

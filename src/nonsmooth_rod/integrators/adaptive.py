@@ -121,7 +121,7 @@ class Stepper:
         started = time.perf_counter()
         kernels = self.engine.kernels
         if self.scene.applied_force is None and self.iparams[loop.I_SOLVER] >= 0:
-            status = kernels.run_steps(1, 1 + n, params, self.iparams, self.model, work, out)
+            status = kernels.run_steps(1, 1 + n, params, self.iparams, self.model, work, out, np.zeros(0))
         else:
             status = self.integrator._run_stepwise(kernels, self.scene, 1, 1 + n, params, self.iparams,
                                                    self.model, work, out)

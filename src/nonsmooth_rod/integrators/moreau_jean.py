@@ -89,7 +89,7 @@ class MoreauJeanOptions:
             self.min_phase = 2 * (self.h if self.tol is None else self.tol)
 
 
-_ENTRY_POINTS = ("run_steps", "compiled_step", "step_force", "begin_step", "assemble", "finish_step", "end_of_step",
+_ENTRY_POINTS = ("run_steps", "step_force", "begin_step", "assemble", "finish_step", "end_of_step",
                  "drive_step", "hold_driven_velocities", "place_driven_bodies", "step_time")
 
 
@@ -160,18 +160,20 @@ PROBE_STEPS = 16
 
 def compiled_part(solver: str, solver_code, callback: bool):
     """(cache part, what it is in words, background job's arguments) of the compiled entry a run
-    uses: the whole-run loop, the step-wise loop (Python force callbacks), or the step kernels
-    around a Python (QP) solver. The exact solvers share each compiled loop."""
+    uses: the loop (whole runs, and one step a call where a Python force is called back between
+    steps — `callback`), or the step kernels around a Python (QP) solver. The exact solvers share
+    the compiled loop."""
     if solver_code is None:
         return "moreau-jean-python-step", "the step kernels around Python solvers", ["--python-step", solver]
-    if callback:
-        return "moreau-jean-step", "the step-wise Moreau–Jean loop (Python force callback)", ["--step"]
-    return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []
+    return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []  # callbacks run it step by step
 
 
 def _calls_back(scene) -> bool:
     """True when a step needs Python: a Python applied_force or a Python (Prescribed) motion."""
     return scene.applied_force is not None or scene.python_motions()
+
+
+NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
 
 
 class Engine:
@@ -351,7 +353,7 @@ class MoreauJean:
         kernels = engine.kernels
         with engine.compiling():
             if not _calls_back(scene) and iparams[loop.I_SOLVER] >= 0:
-                status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out)
+                status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
             else:
                 status = self._run_stepwise(kernels, scene, r0, r0 + n, params, iparams, model, work, out)
         window.r = int(counters[loop.K_DONE])
@@ -373,22 +375,23 @@ class MoreauJean:
         """The loop step by step from Python: for a Python `applied_force` (called back for each
         step's force) and for the Python (QP) solvers."""
         q, v, counters = out[0], out[1], out[9]
-        f = np.empty(scene.n_dof)
-        solver_code = int(iparams[loop.I_SOLVER])
-        compiled_step = kernels.compiled_step if solver_code >= 0 else None
+        f, extra = np.empty(scene.n_dof), np.zeros(scene.n_dof)
+        compiled = int(iparams[loop.I_SOLVER]) >= 0  # an exact solver: the compiled loop, one step a call
         motions = self._packed.motions if scene.python_motions() else ()
         for k in range(r_start, r_end):
-            kernels.step_force(k, params, model, out, f)
             if motions:
                 t = kernels.step_time(params, k)
                 evaluate_python_motions(motions, t, t + params[loop.P_H], model[loop.M_MOTION_NOW])
             if scene.applied_force is not None:
                 t = params[loop.P_T0] + ((params[loop.P_K0] + k) + params[loop.P_THETA]) * params[loop.P_H]
-                f += scene.applied(t, q[k], v[k])
-            if compiled_step is not None:
-                status = compiled_step(k, f, params, iparams, model, work, out)
-            else:
-                status = self._python_solver_step(kernels, k, f, params, iparams, model, work, out)
+                extra[:] = scene.applied(t, q[k], v[k])
+            if compiled:  # books the step itself (end_of_step)
+                if kernels.run_steps(k, k + 1, params, iparams, model, work, out, extra) != loop.RUN_OK:
+                    return counters[loop.K_STATUS]
+                continue
+            kernels.step_force(k, params, model, out, f)
+            f += extra
+            status = self._python_solver_step(kernels, k, f, params, iparams, model, work, out)
             if kernels.end_of_step(k, status, counters) != loop.RUN_OK:
                 return counters[loop.K_STATUS]
         return loop.RUN_OK

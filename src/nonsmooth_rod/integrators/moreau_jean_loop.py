@@ -10,8 +10,8 @@ A step of size h from (q_k, v_k), for a packed scene (model.packing):
                  impacts, contact memory
 
 `run_steps` runs them for a range of steps with the packed forces (the whole run is one
-compiled call, whichever solver iparams names); `compiled_step` runs one step with a force given by the caller (the step-wise
-loop that calls back a Python `applied_force`). Arrays are grouped in three tuples so every
+compiled call, whichever solver iparams names), plus an `extra` force — the step-wise loop that
+calls back a Python `applied_force` runs it one step a call with that force). Arrays are grouped in three tuples so every
 kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
 (records). model and work are built by `_model_and_work` in moreau_jean.py, out by `Window` in
 moreau_jean_records.py (the run in windows of rows). A fourth tuple, the scratch (`step_scratch`,
@@ -84,7 +84,7 @@ N_PARAMS = 7
 I_SOLVER, I_MAX_ITER, I_STOP, I_TIME_INVARIANT = range(4)
 N_IPARAMS = 4
 # Slots of the per-run scratch (step_scratch): the step's temporaries, allocated once per call of
-# run_steps (or compiled_step) instead of ~40 small arrays per step. Sized by the scene's contacts;
+# run_steps instead of ~40 small arrays per step. Sized by the scene's contacts;
 # the dense W (lemke, enum) for steps of up to SCRATCH_W_CONTACTS active contacts, the solver's
 # (kernel_base.solver_scratch) for groups of up to SCRATCH_SOLVER_CONTACTS: larger ones allocate
 # their own, as every step did before.
@@ -624,8 +624,8 @@ def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, p_norma
 @_inlined
 def _step(solver_code, k, f, params, iparams, model, work, out, scratch):
     """One whole step with generalised force f, its temporaries in `scratch` (step_scratch);
-    returns a run status (the solver read from its code at run time: run_steps and compiled_step
-    serve every solver)."""
+    returns a run status (the solver read from its code at run time: run_steps
+    serves every solver)."""
     q, v, counters = out[0], out[1], out[9]
     qk, vk = q[k], v[k]
     driven = model[M_DRIVEN].shape[0] > 0  # (a scene without driven bodies skips their calls: measurably faster)
@@ -715,8 +715,8 @@ def end_of_step(k, status, counters):
 
 
 @jit
-def _run(solver_code, k_start, k_end, params, iparams, model, work, out):
-    """Steps k_start … k_end − 1 with the packed forces: the whole run in one call."""
+def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
+    """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call."""
     f = np.empty(model[0].shape[0])
     scratch = step_scratch(solver_code, model)
     weight, ftable, findex, ftimes, fvalues, q, v = model[1], model[4], model[5], model[6], model[7], out[0], out[1]
@@ -730,6 +730,8 @@ def _run(solver_code, k_start, k_end, params, iparams, model, work, out):
         for c in range(len(REPEATED_COUNTERS)):
             before[k % 3, c] = counters[REPEATED_COUNTERS[c]]
         _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f)
+        for d in range(extra.shape[0]):
+            f[d] += extra[d]
         if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out, scratch), counters) != RUN_OK:
             return counters[K_STATUS]
         for i in range(memory.shape[2]):
@@ -807,22 +809,17 @@ def _repeat_period(k, k_end, period, out, work, memory, before):
 # rod, h = 1e-4, 12.67 / 12.34 / 50.46 µs per step against 12.48 / 12.35 / 49.24 with one literal
 # entry per solver, back to back on a loaded machine), where one entry per solver compiled the
 # whole tree once per solver — a test suite or `nonsmooth-rod compile` compiled it six times.
+# The step-wise loop (a Python applied_force called back between steps) runs this same entry one
+# step at a time with that force in `extra` (a second compiled entry inlined the whole step again
+# and doubled the cold compile).
 @jit
-def run_steps(k_start, k_end, params, iparams, model, work, out):
-    """_run with the solver iparams[I_SOLVER] names."""
-    return _run(iparams[I_SOLVER], k_start, k_end, params, iparams, model, work, out)
+def run_steps(k_start, k_end, params, iparams, model, work, out, extra):
+    """_run with the solver iparams[I_SOLVER] names; `extra`: a generalised force added to the
+    packed forces at every step (empty: none)."""
+    return _run(iparams[I_SOLVER], k_start, k_end, params, iparams, model, work, out, extra)
 
 
-# The same for the step-wise loop (a Python applied_force called back between steps).
-@jit
-def compiled_step(k, f, params, iparams, model, work, out):
-    """One step (_step) with the solver iparams[I_SOLVER] names (its scratch allocated per call: this
-    entry serves the loop that calls a Python force back between steps)."""
-    return _step(iparams[I_SOLVER], k, f, params, iparams, model, work, out,
-                 step_scratch(iparams[I_SOLVER], model))
-
-
-__all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "finish_step", "step_force", "run_steps", "compiled_step",
+__all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "finish_step", "step_force", "run_steps",
            "drive_step", "hold_driven_velocities", "place_driven_bodies",
            "crossing_offset", "ACTIVATION_ROUNDOFF"]
 
