@@ -336,6 +336,8 @@ def _failure(stepper: Stepper, status: int, point: Point, H: float) -> str:
         return f"non-finite state in the step from {where}"
     if status == loop.RUN_BAD_GEOMETRY:
         return f"disk centres coincide in the step from {where}: the contact normal is undefined"
+    if status == loop.RUN_PASSED_THROUGH:
+        return f"a disk passed through its obstacle in the step from {where}"
     err = stepper.integrator._solver_error
     if err is not None:
         return str(err.with_context(where))

@@ -403,8 +403,7 @@ class MoreauJean:
         kernels.drive_step(k, params, model)
         na = kernels.begin_step(params, q[k], v[k], f, model, work)
         if na < 0:
-            counters[loop.K_FAIL_CONTACT] = -1 - na
-            return loop.RUN_BAD_GEOMETRY
+            return loop.geometry_failure(na, model[2].shape[0], counters)
         kernels.hold_driven_velocities(model, work)
         p, u, states = np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
         if na > 0:
@@ -445,6 +444,10 @@ class MoreauJean:
             name = names[int(counters[loop.K_FAIL_CONTACT])]
             return "failed", (f"{name}: disk centres coincide at step {k}, t = {t_k:.9g} s, the contact "
                               "normal is undefined"), None
+        if status == loop.RUN_PASSED_THROUGH:
+            name = names[int(counters[loop.K_FAIL_CONTACT])]
+            return "failed", (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
+                              f"passed through its obstacle within a step; use a smaller h than {grid.h:g} s"), None
         r = k - window.k_base
         state_txt = ", ".join(f"{name}:{STATE_NAMES[states[r - 1, i]] if r else 'initial'}"
                               for i, name in enumerate(names))

@@ -36,11 +36,12 @@ def _inlined(function):
     import numba
 
     return numba.njit(cache=True, inline="always")(function)
-from ..model.contact_kernels import C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_SURFACE_VELOCITY, obstacle_velocity
+from ..model.contact_kernels import (C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
+                                      KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
 from ..model.forces import accumulate_forces
 from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A,
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
                              contact_kinematics, drive_contacts, local_dot)
 from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
@@ -65,6 +66,9 @@ BROAD_PHASE_SLACK = 1e-9
 IMPACT_VELOCITY_TOL = 1e-9
 # Run status codes.
 RUN_OK, RUN_SOLVER_FAILED, RUN_NONFINITE, RUN_STOPPED, RUN_BAD_GEOMETRY = 0, 1, 2, 3, 4
+# A disk's contact deeper than the disk (its centre past the obstacle): the body passed through it within
+# a step far too long for its speed — never a result to report as ok.
+RUN_PASSED_THROUGH = 6
 # (set from Python, between windows: a stop condition held at a kept sample)
 RUN_STOPPED_BY_CONDITION = 5
 # Slots of the int64 `counters` record.
@@ -188,6 +192,29 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
                 j += 1
 
 
+@jit
+def pass_through_depth(table, index, i):
+    """How deep contact i may go before its body has passed through the obstacle: the disk's radius
+    (of two disks the smaller; a disk on a body's corner, the disk's); 0 — no such check — for a
+    point on a line, whose depth has no scale."""
+    kind = index[i, CI_KIND]
+    if kind == KIND_DISK_ON_LINE or kind == KIND_DISK_ON_SEGMENT:
+        return table[i, C_RADIUS_A]
+    if kind == KIND_DISK_ON_DISK:
+        ra, rb = table[i, C_RADIUS_A], table[i, C_RADIUS_B]
+        return max(ra, rb) if min(ra, rb) == 0.0 else min(ra, rb)
+    return 0.0
+
+
+@jit
+def geometry_failure(na, n_contacts, counters):
+    """The run status of begin_step's failure code na < 0 (−1 − i: contact i's normal undefined;
+    −1 − n_contacts − i: contact i passed through), the contact booked in the counters."""
+    code = -1 - na
+    counters[K_FAIL_CONTACT] = code % n_contacts
+    return RUN_BAD_GEOMETRY if code < n_contacts else RUN_PASSED_THROUGH
+
+
 @_inlined
 def begin_step(params, qk, vk, f, model, work):
     """Free velocity, contact kinematics and the active set; returns na (−1 − i: contact i has
@@ -215,6 +242,9 @@ def begin_step(params, qk, vk, f, model, work):
         gap, drift = contact_kinematics(table, index, i, qk, vk, hn[i], ht[i])
         if math.isnan(gap):
             return -1 - i
+        depth = pass_through_depth(table, index, i)
+        if depth > 0.0 and gap < -depth:
+            return -1 - table.shape[0] - i
         gaps[i], drifts[i] = gap, drift
         predicted = gap + gamma * h * relative_normal_velocity(table, hn, ht, index, i, vk, True)
         margin = ACTIVATION_ROUNDOFF
@@ -633,8 +663,7 @@ def _step(solver_code, k, f, params, iparams, model, work, out, scratch):
         drive_step(k, params, model)
     na = begin_step(params, qk, vk, f, model, work)
     if na < 0:
-        counters[K_FAIL_CONTACT] = -1 - na
-        return RUN_BAD_GEOMETRY
+        return geometry_failure(na, model[2].shape[0], counters)
     if driven:
         hold_driven_velocities(model, work)
     p, u, states = scratch[S_FLOATS][:0], scratch[S_FLOATS][:0], scratch[S_STATES][:0]  # no contact: no arrays
@@ -819,7 +848,7 @@ def run_steps(k_start, k_end, params, iparams, model, work, out, extra):
     return _run(iparams[I_SOLVER], k_start, k_end, params, iparams, model, work, out, extra)
 
 
-__all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "finish_step", "step_force", "run_steps",
+__all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "geometry_failure", "finish_step", "step_force", "run_steps",
            "drive_step", "hold_driven_velocities", "place_driven_bodies",
            "crossing_offset", "ACTIVATION_ROUNDOFF"]
 
