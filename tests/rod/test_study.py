@@ -120,3 +120,17 @@ def test_measure_reads_creep_and_impact_error_off_a_run():
     m4 = study.measure(simulate(RodProblem.paper(3), "moreau-jean", h=1e-4), ref)
     assert m["creep_m"] / m4["creep_m"] == pytest.approx(10.0, rel=0.1)
     assert m["max_penetration_m"] < 1e-6 and np.isfinite(m["energy_growth_J"])
+
+
+def test_error_control_is_in_the_chart_with_every_step_it_evaluated():
+    from nonsmooth_rod.rod import study
+    from nonsmooth_rod.rod.simulation import simulate
+
+    assert any(s.knob == "tol" and s.method == "moreau-jean" for s in study.FULL_SWEEPS)
+    ref = study.reference(2)
+    spec = study.RunSpec("moreau-jean", "lemke, tol", 2, "tol", 1e-3, (("solver", "lemke"),))
+    record = study.run_one(spec, ref)
+    assert record["status"] == "ok" and record["phases_ok"]
+    assert record["impact_error_s"] <= 1e-3  # the tolerance holds on the located event time
+    stats = simulate(ref.problem, "moreau-jean", tol=1e-3, solver="lemke").result.stats
+    assert record["work"] == stats["step_evaluations"] > stats["steps"]  # the rejected and doubled steps count

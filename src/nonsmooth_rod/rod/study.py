@@ -86,6 +86,8 @@ FULL_SWEEPS = (
     Sweep("moreau-jean", "enum", "h", (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), (("solver", "enum"),)),
     Sweep("moreau-jean", "pgs", "h", (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), (("solver", "pgs"),)),
     Sweep("moreau-jean", "osqp", "h", (1e-2, 3e-3, 1e-3, 3e-4), (("solver", "osqp"),)),
+    # error control (integrators/adaptive.py): the step sizes chosen for each tolerance
+    Sweep("moreau-jean", "lemke, tol", "tol", (1e-3, 1e-4, 1e-5, 1e-6), (("solver", "lemke"),)),
     *(Sweep("regularized", f"stribeck/{ode}", "epsilon", (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6),
             (("friction_curve", "stribeck"), ("ode_method", ode), ("rtol", REGULARIZED_RTOL)))
       for ode in ("RK45", "DOP853", "Radau", "BDF", "LSODA")),
@@ -224,7 +226,9 @@ def measure(run, ref: Reference) -> dict:
     energy = energy[np.isfinite(energy)]
     energy_growth = float(np.max(energy) - energy[0]) if energy.size else math.nan
     stats = run.result.stats
-    work = int(run.result.steps) if run.method == "moreau-jean" else int(stats.get("nfev", run.result.steps))
+    # steps solved: with tol, every step evaluated (the rejected and doubled ones too), not only those kept
+    work = int(stats.get("step_evaluations", run.result.steps)) if run.method == "moreau-jean" else \
+        int(stats.get("nfev", run.result.steps))
     return {"cpu_s": float(run.result.cpu_time_s), "work": work, "impact_t": impact_t,
             "impact_error_s": impact_error, "x_O_error_m": x_error, "phases_ok": phases_ok,
             "phase_sequence_ok": bool(same), "phase_boundary_error_s": boundary_error, "creep_m": creep,
@@ -432,7 +436,7 @@ def plot_work_precision(records: list[dict], path) -> None:
     from ..io import atomic_path
 
     palettes = {"event-driven": ["black"],
-                "moreau-jean": ["#08306b", "#17becf", "#6baed6", "#393b79"],
+                "moreau-jean": ["#08306b", "#17becf", "#6baed6", "#393b79", "#fd8d3c"],
                 "regularized": ["#d62728", "#ff7f0e", "#8c564b", "#e377c2", "#9467bd", "#bcbd22", "#7f0000"],
                 "switched": ["#2ca02c", "#74c476"]}
     styles = {"event-driven": "-", "moreau-jean": "-", "regularized": "--", "switched": ":"}
