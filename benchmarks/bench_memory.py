@@ -73,10 +73,15 @@ def library_case_fresh(steps: int, save_every) -> dict:
     0.0 MB of growth after another one)."""
     import json
 
+    here = str(Path(__file__).resolve().parent)
+    # First a process that only runs the scene: if this copy of the package has not compiled that run
+    # yet, it compiles and caches it there — compiling in the measured process would leave hundreds of
+    # MB freed for the run to reuse, and its growth would read low (a cold CI machine: 5 MB for 20 MB).
+    warm = "import sys; sys.path.insert(0, sys.argv[1]); import bench_memory; bench_memory.library_case(200, None)"
+    subprocess.run([sys.executable, "-c", warm, here], env=_env(), capture_output=True, text=True, check=True)
     code = ("import json, sys; sys.path.insert(0, sys.argv[1]); import bench_memory; "
             f"print(json.dumps(bench_memory.library_case({steps}, {save_every!r})))")
-    done = subprocess.run([sys.executable, "-c", code, str(Path(__file__).resolve().parent)], env=_env(),
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run([sys.executable, "-c", code, here], env=_env(), capture_output=True, text=True, check=True)
     return json.loads(done.stdout.splitlines()[-1])
 
 
