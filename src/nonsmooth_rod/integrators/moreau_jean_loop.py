@@ -755,19 +755,24 @@ def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
     memory = np.empty((3, 3, model[2].shape[0]))
     before = np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64)
     k = k_start
+    # the ring's bookkeeping only where a rest can be repeated (not for a time-varying scene, nor the
+    # one-step calls of the step-wise loop)
+    repeats = iparams[I_TIME_INVARIANT] != 0 and k_end - k_start > 2
     while k < k_end:
-        for c in range(len(REPEATED_COUNTERS)):
-            before[k % 3, c] = counters[REPEATED_COUNTERS[c]]
+        if repeats:
+            for c in range(len(REPEATED_COUNTERS)):
+                before[k % 3, c] = counters[REPEATED_COUNTERS[c]]
         _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f)
         for d in range(extra.shape[0]):
             f[d] += extra[d]
         if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out, scratch), counters) != RUN_OK:
             return counters[K_STATUS]
-        for i in range(memory.shape[2]):
-            memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = work[5][i], work[6][i], work[7][i]
-        period = _fixed_period(k, k - k_start + 1, out, memory) if iparams[I_TIME_INVARIANT] and k + 1 < k_end else 0
-        if period > 0:
-            k = _repeat_period(k, k_end, period, out, work, memory, before)
+        if repeats:
+            for i in range(memory.shape[2]):
+                memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = work[5][i], work[6][i], work[7][i]
+            period = _fixed_period(k, k - k_start + 1, out, memory) if k + 1 < k_end else 0
+            if period > 0:
+                k = _repeat_period(k, k_end, period, out, work, memory, before)
         k += 1
     return RUN_OK
 
