@@ -75,7 +75,25 @@ def jit(function):
 
     if not _purged:
         purge_stale_kernels()
-    return numba.njit(cache=True)(function)
+    # NRT set here, not inherited: a function the step's borrowing ones call keeps its reference
+    # counting (numba's callees inherit an unset NRT flag from their caller)
+    return numba.njit(cache=True, _nrt=True)(function)
+
+
+def jit_borrowing(function):
+    """jit without reference counting (numba's NRT off): for the step's hot functions, which only
+    borrow arrays their caller keeps alive. numba counts a reference (an atomic increment and
+    decrement) for every array argument, view and tuple member bound in a function, and in the
+    step's long functions its pruning pass leaves most of them: ~300 a step for one contact, most of
+    the step's time (measured with gdb on NRT_incref). Such a function must not allocate, and
+    must not return an array or take one from a function that allocates it."""
+    if not ENABLED:
+        return function
+    import numba
+
+    if not _purged:
+        purge_stale_kernels()
+    return numba.njit(cache=True, _nrt=False)(function)
 
 
 def jitable(function):

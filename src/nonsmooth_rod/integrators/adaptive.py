@@ -89,11 +89,7 @@ class Attempt:
 
 def _out_arrays(n_dof: int, nc: int, steps: int):
     """A loop `out` tuple: row 0 the step before (warm start), row 1 the start, `steps` steps."""
-    rows = steps + 1
-    return (np.zeros((rows + 1, n_dof)), np.zeros((rows + 1, n_dof)), np.zeros((rows, nc)), np.zeros((rows, nc)),
-            np.zeros((rows, nc)), np.zeros((rows, nc), dtype=np.int64), np.zeros(4 * nc * steps + 4),
-            np.zeros(4 * nc * steps + 4, dtype=np.int64), np.zeros(4 * nc * steps + 4, dtype=np.int64),
-            np.zeros(loop.N_COUNTERS, dtype=np.int64), np.zeros((rows, 0)))  # no joints (refused with tol)
+    return loop.new_records(n_dof, nc, steps + 1, 4 * nc * steps + 4, 0)  # no joints (refused with tol)
 
 
 class Stepper:

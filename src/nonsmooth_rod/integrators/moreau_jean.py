@@ -107,12 +107,12 @@ def _model_and_work(packed, resume: ResumeState | None, driven_origin=None, join
     n_dof, nc = packed.minv.shape[0], packed.n_contacts
     if joints is None:
         joints = pack_joints((), n_dof // 3)
-    model = (packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
-             packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
-             packed.pair_keys, packed.pair_contact) + _drive_slots(packed, driven_origin) + (joints,)
-    work = (np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
-            np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-            np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
+    model = loop.Model(packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
+                       packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
+                       packed.pair_keys, packed.pair_contact, *_drive_slots(packed, driven_origin), joints)
+    work = loop.Work(np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
+                     np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
+                     np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
     if resume is not None:
         work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
             resume.was_closed, resume.grazing, resume.slip_sign

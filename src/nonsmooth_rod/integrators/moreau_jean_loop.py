@@ -21,11 +21,12 @@ allocated once per call of the loop, so that a step allocates nothing.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 
 from .. import _jit
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 
 
 def _inlined(function):
@@ -42,7 +43,7 @@ from ..model.forces import accumulate_forces
 from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
-                             contact_kinematics, drive_contacts, local_dot)
+                             contact_kinematics, drive_contacts, row_dot)
 from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
                          project_positions)
@@ -106,6 +107,29 @@ M_JOINTS = 18
 WORK_JOINTS = 11
 # out: each step's joint impulses (rows × 2 per joint).
 O_JOINT_IMPULSE = 10
+# The loop's data, by name (as MuJoCo's mjModel / mjData): the packed scene (moreau_jean._model_and_work),
+# the contacts' per-step memory and scratch, and the run's records (moreau_jean_records.Window). The
+# step's functions take the arrays they use, unpacked once per run (run_arrays): a tuple of arrays
+# passed across a call costs an atomic reference count per array, and that was most of a step
+# (~300 a step for one contact, measured with gdb on NRT_incref).
+Model = namedtuple("Model", "minv weight contacts contact_index force_table force_index force_times force_values "
+                   "disks disk_body pair_keys pair_contact motions motion_times motion_values motion_now driven "
+                   "driven_origin joints")
+Work = namedtuple("Work", "gaps drifts hn ht active was_closed grazing slip_sign v_free a_free candidate joint_buffer")
+Records = namedtuple("Records", "q v p_normal p_tangent slip states impact_t impact_step impact_contact counters "
+                     "joint_impulse")
+# A step's temporaries (step_scratch), allocated once per call of the loop.
+Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints sparse_ints sparse_floats")
+
+
+def new_records(n_dof, n_contacts, rows, impacts, joint_rows):
+    """Records of `rows` steps (rows + 1 states), room for `impacts` impacts, `joint_rows` joint
+    impulses a step: the one constructor of the loop's `out` (moreau_jean_records.Window, adaptive)."""
+    per_step = (rows, n_contacts)
+    return Records(np.zeros((rows + 1, n_dof)), np.zeros((rows + 1, n_dof)), np.zeros(per_step), np.zeros(per_step),
+                   np.zeros(per_step), np.zeros(per_step, dtype=np.int64), np.zeros(impacts),
+                   np.zeros(impacts, dtype=np.int64), np.zeros(impacts, dtype=np.int64),
+                   np.zeros(N_COUNTERS, dtype=np.int64), np.zeros((rows, joint_rows)))
 
 
 @_inlined
@@ -120,13 +144,13 @@ def _obstacle_velocity(table, hn, ht, i, at_start):
 @_inlined
 def relative_normal_velocity(table, hn, ht, index, i, x, at_start):
     """u_N of contact i at the scene velocity x: H_N x less the obstacle's normal velocity."""
-    return local_dot(hn[i], index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[0]
+    return row_dot(hn, index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[0]
 
 
 @_inlined
 def relative_slip_velocity(table, hn, ht, index, i, x, at_start):
     """u_T of contact i at the scene velocity x: H_T x less the obstacle's (and a belt's) tangential velocity."""
-    return local_dot(ht[i], index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[1]
+    return row_dot(ht, index, i, x) - _obstacle_velocity(table, hn, ht, i, at_start)[1]
 
 
 @jit
@@ -215,22 +239,29 @@ def geometry_failure(na, n_contacts, counters):
     return RUN_BAD_GEOMETRY if code < n_contacts else RUN_PASSED_THROUGH
 
 
-@_inlined
+@jit
 def begin_step(params, qk, vk, f, model, work):
-    """Free velocity, contact kinematics and the active set; returns na (−1 − i: contact i has
-    coincident disk centres)."""
-    minv, table, index = model[0], model[2], model[3]  # only what is used: each array costs refcounting
-    gaps, drifts, hn, ht, active, was_closed = work[0], work[1], work[2], work[3], work[4], work[5]
-    v_free, a_free, candidate = work[8], work[9], work[10]
+    """begin_arrays on the model and work tuples (the step-wise loop's entry)."""
+    return begin_arrays(params, qk, vk, f, model.minv, model.contacts, model.contact_index, model.disks,
+                        model.disk_body, model.pair_keys, model.pair_contact, model.joints, work.joint_buffer,
+                        work.gaps, work.drifts, work.hn, work.ht, work.active, work.was_closed, work.v_free,
+                        work.a_free, work.candidate)
+
+
+@jit_borrowing
+def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_keys, pair_contact, joints,
+                 joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate):
+    """Free velocity, contact kinematics and the active set; returns na (< 0: geometry_failure's
+    code: −1 − i, contact i's normal undefined; −1 − n_contacts − i, contact i passed through)."""
     h, gamma = params[P_H], params[P_GAMMA]
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
         v_free[d] = vk[d] + h * a_free[d]
-    if model[M_JOINTS].shape[0] > 0:  # (arrays, not the tuples: a call with them costs every step)
-        _joints_begin(qk, minv, model[M_JOINTS], work[WORK_JOINTS], v_free, a_free)
-    broad = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
+    if joints.shape[0] > 0:
+        _joints_begin(qk, minv, joints, joint_buffer, v_free, a_free)
+    broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
     if broad:
-        broad_phase(h, qk, vk, model[8], model[9], model[10], model[11], was_closed, candidate)
+        broad_phase(h, qk, vk, disks, disk_body, pair_keys, pair_contact, was_closed, candidate)
     na = 0
     for i in range(table.shape[0]):
         if broad and not candidate[i]:
@@ -251,7 +282,7 @@ def begin_step(params, qk, vk, f, model, work):
         if was_closed[i]:
             # the grid's h, not a shortened last step's: a contact resting at the gap the full steps
             # left it stays closed through the last step (else the ball falls for that step)
-            margin = persistence_margin(params[P_H_GRID], drift, local_dot(hn[i], index, i, a_free))
+            margin = persistence_margin(params[P_H_GRID], drift, row_dot(hn, index, i, a_free))
         if predicted <= margin:
             active[na] = i
             na += 1
@@ -279,6 +310,28 @@ def _fill_block(blocks, k, hn, ht, index, i, j, minv):
                     tn += a_t * b_n
                     tt += a_t * b_t
     blocks[k, 0, 0], blocks[k, 0, 1], blocks[k, 1, 0], blocks[k, 1, 1] = nn, nt, tn, tt
+
+
+@_inlined
+def _fill_dense_block(W, a, b, hn, ht, index, i, j, minv):
+    """W's 2×2 block (a, b) of active contacts i, j, as _fill_block computes it (the same sums in
+    the same order), written in place."""
+    nn, nt, tn, tt = 0.0, 0.0, 0.0, 0.0
+    for side_i in range(2):
+        body = index[i, CI_BODY_A + side_i]
+        if body < 0:
+            continue
+        for side_j in range(2):
+            if index[j, CI_BODY_A + side_j] == body:
+                for d in range(3):
+                    w = minv[3 * body + d]
+                    a_n, a_t = hn[i, 3 * side_i + d] * w, ht[i, 3 * side_i + d] * w
+                    b_n, b_t = hn[j, 3 * side_j + d], ht[j, 3 * side_j + d]
+                    nn += a_n * b_n
+                    nt += a_n * b_t
+                    tn += a_t * b_n
+                    tt += a_t * b_t
+    W[2 * a, 2 * b], W[2 * a, 2 * b + 1], W[2 * a + 1, 2 * b], W[2 * a + 1, 2 * b + 1] = nn, nt, tn, tt
 
 
 @jit
@@ -361,13 +414,19 @@ def _sparse_capacity(index, n_bodies):
     return blocks
 
 
-@_inlined
+@jit
 def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing, resting):
+    """assemble_arrays on the model and work tuples (the step-wise loop's entry)."""
+    assemble_arrays(params, na, qk, vk, model.minv, model.contacts, model.contact_index, model.joints,
+                    work.joint_buffer, work.gaps, work.hn, work.ht, work.active, work.was_closed, work.grazing,
+                    work.slip_sign, work.v_free, W, q_step, guess, mu_s, mu_d, closing, resting)
+
+
+@jit_borrowing
+def assemble_arrays(params, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht, active, was_closed,
+                    grazing, slip_sign, v_free, W, q_step, guess, mu_s, mu_d, closing, resting):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd;
     `resting` is 1 for a contact loaded in the previous step or not slipping at the step's start."""
-    minv, table, index = model[0], model[2], model[3]
-    gaps, hn, ht, active, was_closed, slip_sign, v_free = work[0], work[2], work[3], work[4], work[5], work[7], work[8]
-    grazing = work[6]
     h = params[P_H]
     # A gap of a few ulps of the positions is no gap: closing it would ask a velocity round-off/h
     # that a body's other contacts cannot all follow (a statically indeterminate body would slip).
@@ -379,13 +438,11 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
     rest_tol = 1e-12
     for d in range(vk.shape[0]):
         rest_tol = max(rest_tol, 1e-9 * abs(vk[d]))
-    block = np.empty((1, 2, 2))  # like delassus_blocks' blocks: _fill_block compiles once
     for a in range(na):
         i = active[a]
         for b in range(na if W.shape[0] > 0 else 0):  # dense W: for lemke and enum
             j = active[b]
-            _fill_block(block, 0, hn, ht, index, i, j, minv)
-            W[2 * a: 2 * a + 2, 2 * b: 2 * b + 2] = block[0]
+            _fill_dense_block(W, a, b, hn, ht, index, i, j, minv)
         q_step[2 * a + 1] = relative_slip_velocity(table, hn, ht, index, i, v_free, False)
         # only a contact at rest — loaded in the previous step, or not slipping at the step's start —
         # is held by a search over admissible splits (sticking.py); one grazing a rolling
@@ -410,8 +467,8 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
             # a closing contact slides the way it arrives
             u_t = relative_slip_velocity(table, hn, ht, index, i, vk, True)
             guess[a] = 0.0 if abs(u_t) < 1e-12 else math.copysign(1.0, u_t)
-    if model[M_JOINTS].shape[0] > 0:
-        _joints_delassus(na, active, hn, ht, index, minv, model[M_JOINTS], work[WORK_JOINTS], W)
+    if joints.shape[0] > 0:
+        _joints_delassus(na, active, hn, ht, index, minv, joints, joint_buffer, W)
 
 
 @jit
@@ -438,32 +495,36 @@ def crossing_offset(g, u, a, h):
 
 
 @jit
-def _record_impact(k, t, i, u_before, work, model, out, params, iparams):
-    gaps, drifts, hn, a_free = work[0], work[1], work[2], work[9]
-    index = model[3]
-    impact_t, impact_step, impact_contact, counters = out[6], out[7], out[8], out[9]
-    h = params[P_H]
+def _record_impact(k, t, i, u_before, gap, acceleration, params, iparams, impact_t, impact_step, impact_contact,
+                   counters):
+    """Book contact i's impact in step k (its gap at the step's start, u_N before, normal
+    acceleration); True when it is the stop contact's."""
     n = counters[K_N_IMPACTS]
     if n >= impact_t.shape[0]:  # the record is full: the impact still acts, unrecorded
         return i == iparams[I_STOP]
-    impact_t[n] = t + crossing_offset(gaps[i], u_before, local_dot(hn[i], index, i, a_free) + drifts[i], h)
+    impact_t[n] = t + crossing_offset(gap, u_before, acceleration, params[P_H])
     impact_step[n] = k
     impact_contact[n] = i
     counters[K_N_IMPACTS] = n + 1
     return i == iparams[I_STOP]
 
 
-@_inlined
+@jit
 def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
-    """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
-    status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
-    minv, table, index = model[0], model[2], model[3]
-    hn, ht, active, was_closed, grazing, slip_sign, v_free = work[2], work[3], work[4], work[5], work[6], work[7], work[8]
-    q, v, p_normal, p_tangent, slip, state_rec = out[0], out[1], out[2], out[3], out[4], out[5]
-    h, theta = params[P_H], params[P_THETA]
-    t = step_time(params, k)
-    v_next = v[k + 1]
-    v_next[:] = v_free
+    """finish_arrays on the model, work and out tuples (the step-wise loop's entry)."""
+    return finish_arrays(k, params, iparams, na, p, u, states, qk, vk, model.minv, model.contacts,
+                         model.contact_index, model.pair_keys, model.joints, work.joint_buffer, work.gaps,
+                         work.drifts, work.hn, work.ht, work.active, work.was_closed, work.grazing, work.slip_sign,
+                         work.v_free, work.a_free, work.candidate, out.q, out.v, out.p_normal, out.p_tangent,
+                         out.slip, out.states, out.impact_t, out.impact_step, out.impact_contact, out.counters,
+                         out.joint_impulse)
+
+
+@_inlined
+def _end_velocity(na, p, minv, index, hn, ht, active, v_free, v_next):
+    """v_{k+1} = v_free + M⁻¹ Hᵀ p (element by element: a slice copy needs numba's NRT)."""
+    for d in range(v_next.shape[0]):
+        v_next[d] = v_free[d]
     for a in range(na):
         i = active[a]
         for side in range(2):
@@ -472,17 +533,30 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
                 for d in range(3):
                     v_next[3 * body + d] += minv[3 * body + d] * (hn[i, 3 * side + d] * p[2 * a]
                                                                   + ht[i, 3 * side + d] * p[2 * a + 1])
-    joints = model[M_JOINTS].shape[0] > 0
-    if joints:
-        _joints_finish(v_next, minv, model[M_JOINTS], work[WORK_JOINTS], out[O_JOINT_IMPULSE][k])
+
+
+@jit_borrowing
+def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, index, pair_keys, joints, joint_buffer,
+                  gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, q, v,
+                  p_normal, p_tangent, slip, state_rec, impact_t, impact_step, impact_contact, counters,
+                  joint_impulse):
+    """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
+    status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
+    h, theta = params[P_H], params[P_THETA]
+    t = step_time(params, k)
+    v_next = v[k + 1]
+    _end_velocity(na, p, minv, index, hn, ht, active, v_free, v_next)
+    jointed = joints.shape[0] > 0
+    if jointed:
+        _joints_finish(v_next, minv, joints, joint_buffer, joint_impulse[k])
     finite = True
     for d in range(qk.shape[0]):
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
-    if joints and finite:
-        _joints_project(q[k + 1], na, states, active, hn, ht, index, minv, model[M_JOINTS], work[WORK_JOINTS])
+    if jointed and finite:
+        _joints_project(q[k + 1], na, states, active, hn, ht, index, minv, joints, joint_buffer)
     status = RUN_OK
-    broad, candidate = model[10].shape[0] > BROAD_PHASE_MIN_PAIRS, work[10]  # as begin_step's broad phase
+    broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # as begin_arrays' broad phase
     for i in range(table.shape[0]):
         p_normal[k, i] = 0.0
         p_tangent[k, i] = 0.0
@@ -496,7 +570,8 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     for a in range(na):
         i = active[a]
         p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]
-        if states[a] == STATE_OPEN and was_closed[i] and _rides_the_gap(i, params, work, table, index, v_next):
+        if states[a] == STATE_OPEN and was_closed[i] and _rides_the_gap(i, params, gaps, drifts, hn, ht, a_free,
+                                                                        table, index, v_next):
             grazing[i] = 1  # no force this step (reported open), yet not apart: no impact on return
         slip_sign[i] = 1.0 if state_rec[k, i] == STATE_SLIP_PLUS else (-1.0 if state_rec[k, i] == STATE_SLIP_MINUS
                                                                         else 0.0)
@@ -507,8 +582,9 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
             # contact that rode its gap without impulse for a step stays closed (grazing), so it
             # is not one.
             u_before = relative_normal_velocity(table, hn, ht, index, i, vk, True)
-            if u_before < -IMPACT_VELOCITY_TOL and _record_impact(k, t, i, u_before, work, model, out, params,
-                                                                  iparams):
+            if u_before < -IMPACT_VELOCITY_TOL and _record_impact(
+                    k, t, i, u_before, gaps[i], row_dot(hn, index, i, a_free) + drifts[i], params, iparams, impact_t,
+                    impact_step, impact_contact, counters):
                 status = RUN_STOPPED
         was_closed[i] = 1 if closed or grazing[i] else 0
     if not finite:
@@ -561,15 +637,14 @@ def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buff
 
 
 @jit
-def _rides_the_gap(i, params, work, table, index, v_next):
+def _rides_the_gap(i, params, gaps, drifts, hn, ht, a_free, table, index, v_next):
     """A persistent contact that got no impulse but ends the step within h² |g̈| of
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
     step is no impact — near a lift-off the normal force fades and such steps alternate with
     loaded ones."""
-    gaps, drifts, hn, ht, a_free = work[0], work[1], work[2], work[3], work[9]
     h = params[P_H]
     # within one step's worth of its acceleration, h² |g̈|: a hop of a ball at rest is longer
-    margin = h * h * (abs(drifts[i]) + abs(local_dot(hn[i], index, i, a_free))) + ACTIVATION_ROUNDOFF
+    margin = h * h * (abs(drifts[i]) + abs(row_dot(hn, index, i, a_free))) + ACTIVATION_ROUNDOFF
     return gaps[i] + h * relative_normal_velocity(table, hn, ht, index, i, v_next, False) <= margin
 
 
@@ -586,124 +661,152 @@ def _warm_start(k, na, active, was_closed, p_normal, p_tangent, p):
 
 @jit
 def step_scratch(solver_code, model):
-    """The per-run scratch tuple (S_* slots) for the packed scene `model`."""
-    n_contacts, n_bodies = model[2].shape[0], model[0].shape[0] // 3
+    """The per-run scratch (Scratch) for the packed scene `model`."""
+    n_contacts, n_bodies = model.contacts.shape[0], model.minv.shape[0] // 3
     sparse = solver_code == SOLVER_PGS
     dense = 0 if sparse else min(n_contacts, SCRATCH_W_CONTACTS)
-    blocks = _sparse_capacity(model[3], n_bodies) if sparse else 0
+    blocks = _sparse_capacity(model.contact_index, n_bodies) if sparse else 0
     solver_floats, solver_ints = solver_scratch(min(n_contacts, SCRATCH_SOLVER_CONTACTS))
     sparse_ints = 2 * n_bodies + 4 * n_contacts + 3 + blocks if sparse else 0
-    return (np.empty(11 * n_contacts), np.empty(n_contacts, dtype=np.int64), np.empty(4 * dense * dense),
-            solver_floats, solver_ints, np.empty(sparse_ints, dtype=np.int64), np.empty(4 * blocks))
+    return Scratch(np.empty(11 * n_contacts), np.empty(n_contacts, dtype=np.int64), np.empty(4 * dense * dense),
+                   solver_floats, solver_ints, np.empty(sparse_ints, dtype=np.int64), np.empty(4 * blocks))
 
 
 @_inlined
-def _dense_matrix(scratch, m, sparse):
+def _dense_matrix(scratch_w, m, sparse):
     """The step's dense W (m × m, every entry written by assemble): a view of the scratch, empty
     for pgs, or a matrix of its own beyond the scratch's size."""
     if sparse:
-        return carve_matrix(scratch[S_W], 0, 0, 0)[0]
-    if m * m <= scratch[S_W].shape[0]:
-        return carve_matrix(scratch[S_W], 0, m, m)[0]
+        return carve_matrix(scratch_w, 0, 0, 0)[0]
+    if m * m <= scratch_w.shape[0]:
+        return carve_matrix(scratch_w, 0, m, m)[0]
     return np.empty((m, m))
 
 
-@_inlined
-def solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, p_normal, p_tangent, counters, scratch):
-    """assemble + the two-coefficient kernel, in the per-run scratch; p_normal, p_tangent: the
-    records (the warm start), counters: out's. Returns (kernel status, p, u, states). (Inlined
-    functions take only the arrays they use: each array of a tuple passed in costs ~10 ns of
-    reference counting per step.)"""
+@jit
+def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht,
+                 active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, s_floats, s_w,
+                 s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats, p, u, states):
+    """assemble + the two-coefficient kernel into p, u, states (step_impulses' views), in the
+    per-run scratch (s_*: Scratch's arrays); p_normal, p_tangent: the records (the warm start).
+    Returns the kernel status. (It counts references: it may allocate, a W beyond the scratch.)"""
     m = 2 * na
     # pgs sweeps the block-sparse W; lemke, enum need it dense, and so do joints (W_c couples a cluster)
-    sparse = solver_code == SOLVER_PGS and model[M_JOINTS].shape[0] == 0
-    W = _dense_matrix(scratch, m, sparse)
-    floats = scratch[S_FLOATS]
-    q_step, at = carve(floats, 0, m)
-    guess, at = carve(floats, at, na)
-    mu_s, at = carve(floats, at, na)
-    mu_d, at = carve(floats, at, na)
-    closing, at = carve(floats, at, na)
-    resting, at = carve(floats, at, na)
-    p, at = carve(floats, at, m)
-    u, at = carve(floats, at, m)
-    states = scratch[S_STATES][:na]
-    assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, closing, resting)
+    sparse = solver_code == SOLVER_PGS and joints.shape[0] == 0
+    W = _dense_matrix(s_w, m, sparse)
+    q_step, at = carve(s_floats, 0, m)
+    guess, at = carve(s_floats, at, na)
+    mu_s, at = carve(s_floats, at, na)
+    mu_d, at = carve(s_floats, at, na)
+    closing, at = carve(s_floats, at, na)
+    resting, at = carve(s_floats, at, na)
+    assemble_arrays(params, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht, active, was_closed,
+                    grazing, slip_sign, v_free, W, q_step, guess, mu_s, mu_d, closing, resting)
     p[:] = 0.0
     u[:] = 0.0
     states[:] = 0
-    _warm_start(k, na, work[4], work[5], p_normal, p_tangent, p)
+    _warm_start(k, na, active, was_closed, p_normal, p_tangent, p)
     if sparse:
-        indptr, indices, blocks = delassus_blocks(na, model[0], model[3], work[2], work[3], work[4],
-                                                  scratch[S_SPARSE_INTS], scratch[S_SPARSE_FLOATS])
+        indptr, indices, blocks = delassus_blocks(na, minv, index, hn, ht, active, s_sparse_ints, s_sparse_floats)
         status, solves, iterations, consistent, fallbacks = two_coefficient_into(
             solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL],
-            iparams[I_MAX_ITER], p, u, states, scratch[S_SOLVER_FLOATS], scratch[S_SOLVER_INTS])
+            iparams[I_MAX_ITER], p, u, states, s_solver_floats, s_solver_ints)
     else:  # lemke, enum: one group of coupled contacts at a time (their cost grows with the group)
         status, solves, iterations, consistent, fallbacks = two_coefficient_by_group(
             solver_code, W, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL], iparams[I_MAX_ITER], p, u,
-            states, scratch[S_SOLVER_FLOATS], scratch[S_SOLVER_INTS])
+            states, s_solver_floats, s_solver_ints)
     counters[K_SOLVES] += solves
     counters[K_ITERATIONS] += iterations
     counters[K_FALLBACKS] += fallbacks
     if status == KERNEL_SOLVED and not consistent:
         counters[K_INCONSISTENT] += 1
-    return status, p, u, states
-
-
-@_inlined
-def _step(solver_code, k, f, params, iparams, model, work, out, scratch):
-    """One whole step with generalised force f, its temporaries in `scratch` (step_scratch);
-    returns a run status (the solver read from its code at run time: run_steps
-    serves every solver)."""
-    q, v, counters = out[0], out[1], out[9]
-    qk, vk = q[k], v[k]
-    driven = model[M_DRIVEN].shape[0] > 0  # (a scene without driven bodies skips their calls: measurably faster)
-    if model[M_MOTIONS].shape[0] > 0:
-        drive_step(k, params, model)
-    na = begin_step(params, qk, vk, f, model, work)
-    if na < 0:
-        return geometry_failure(na, model[2].shape[0], counters)
-    if driven:
-        hold_driven_velocities(model, work)
-    p, u, states = scratch[S_FLOATS][:0], scratch[S_FLOATS][:0], scratch[S_STATES][:0]  # no contact: no arrays
-    if na > 0:
-        status, p, u, states = solve_step(solver_code, k, params, iparams, na, qk, vk, model, work, out[2], out[3],
-                                          counters, scratch)
-        if status != KERNEL_SOLVED:
-            counters[K_SOLVER_STATUS] = status
-            return RUN_SOLVER_FAILED
-    status = finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out)
-    if driven:
-        place_driven_bodies(k, model, out)
     return status
 
 
 @_inlined
+def step_impulses(na, s_floats, s_states):
+    """(p, u, states) of a step with na active contacts: views of the scratch after the step
+    problem's 7 na floats (q_step, guess, μs, μd, closing, resting; solve_arrays carves them)."""
+    return s_floats[7 * na: 9 * na], s_floats[9 * na: 11 * na], s_states[:na]
+
+
+@jit_borrowing
+def step_arrays(solver_code, k, f, params, iparams,
+                minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys,
+                pair_contact, motions, motion_times, motion_values, motion_now, driven, driven_origin, joints,
+                gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, joint_buffer,
+                q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step, impact_contact, counters,
+                joint_impulse,
+                s_floats, s_states, s_w, s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats):
+    """One whole step with generalised force f, on the arrays of Model, Work, Records and Scratch
+    in their order; returns a run status (the solver read from its code at run time)."""
+    qk, vk = q[k], v[k]
+    if motions.shape[0] > 0:  # (a scene without driven obstacles or bodies skips their calls)
+        drive_arrays(k, params, table, motions, motion_times, motion_values, motion_now)
+    na = begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_keys, pair_contact, joints,
+                      joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate)
+    if na < 0:
+        return geometry_failure(na, table.shape[0], counters)
+    if driven.shape[0] > 0:
+        hold_driven_arrays(driven, motion_now, v_free)
+    p, u, states = step_impulses(na, s_floats, s_states)  # (empty without contacts)
+    if na > 0:
+        status = solve_arrays(
+            solver_code, k, params, iparams, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht,
+            active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, s_floats, s_w,
+            s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats, p, u, states)
+        if status != KERNEL_SOLVED:
+            counters[K_SOLVER_STATUS] = status
+            return RUN_SOLVER_FAILED
+    status = finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, index, pair_keys, joints,
+                           joint_buffer, gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free,
+                           candidate, q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step,
+                           impact_contact, counters, joint_impulse)
+    if driven.shape[0] > 0:
+        place_driven_arrays(k, driven, driven_origin, motion_now, q, v)
+    return status
+
+
+@jit
 def drive_step(k, params, model):
+    """drive_arrays on the model tuple (the step-wise loop's entry)."""
+    drive_arrays(k, params, model.contacts, model.motions, model.motion_times, model.motion_values, model.motion_now)
+
+
+@jit
+def drive_arrays(k, params, table, motions, motion_times, motion_values, motion_now):
     """Step k's driven obstacles and bodies: the motions at its start and end (the compiled ones;
     the step-wise loop wrote the Python ones), the driven obstacles' contact rows moved there."""
     t = step_time(params, k)
-    evaluate_motions(t, t + params[P_H], model[M_MOTIONS], model[M_MOTION_TIMES], model[M_MOTION_VALUES],
-                     model[M_MOTION_NOW])
-    drive_contacts(model[2], model[M_MOTION_NOW])
+    evaluate_motions(t, t + params[P_H], motions, motion_times, motion_values, motion_now)
+    drive_contacts(table, motion_now)
 
 
-@_inlined
+@jit
 def hold_driven_velocities(model, work):
+    """hold_driven_arrays on the tuples (the step-wise loop's entry)."""
+    hold_driven_arrays(model.driven, model.motion_now, work.v_free)
+
+
+@jit
+def hold_driven_arrays(driven, now, v_free):
     """A driven body's free velocity is its prescribed velocity at the step's end: with M⁻¹ = 0 no
     force or impulse changes it, so the contacts see it move as prescribed."""
-    driven, now, v_free = model[M_DRIVEN], model[M_MOTION_NOW], work[8]
     for r in range(driven.shape[0]):
         j, m = 3 * driven[r, 0], driven[r, 1]
         for d in range(3):
             v_free[j + d] = now[m, NOW_VELOCITY + d]
 
 
-@_inlined
+@jit
 def place_driven_bodies(k, model, out):
+    """place_driven_arrays on the tuples (the step-wise loop's entry)."""
+    place_driven_arrays(k, model.driven, model.driven_origin, model.motion_now, out.q, out.v)
+
+
+@jit
+def place_driven_arrays(k, driven, origin, now, q, v):
     """A driven body's end-of-step state is its prescribed one (not the θ-method's quadrature of it)."""
-    driven, origin, now, q, v = model[M_DRIVEN], model[M_DRIVEN_ORIGIN], model[M_MOTION_NOW], out[0], out[1]
     for r in range(driven.shape[0]):
         j, m = 3 * driven[r, 0], driven[r, 1]
         for d in range(3):
@@ -717,16 +820,18 @@ def step_time(params, k):
     return params[P_T0] + (params[P_K0] + k) * params[P_H]
 
 
-@_inlined
+@jit
 def step_force(k, params, model, out, f):
     """f = weight + the packed forces at t_k + θh and (q_k, v_k)."""
-    _packed_force(k, params, model[1], model[4], model[5], model[6], model[7], out[0], out[1], f)
+    _packed_force(k, params, model.weight, model.force_table, model.force_index, model.force_times,
+                  model.force_values, out.q, out.v, f)
 
 
 @_inlined
 def _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f):
     """step_force on the force arrays themselves (the whole-run loop unpacks them once)."""
-    f[:] = weight
+    for d in range(f.shape[0]):
+        f[d] = weight[d]
     t = params[P_T0] + ((params[P_K0] + k) + params[P_THETA]) * params[P_H]
     if ftable.shape[0] > 0:
         accumulate_forces(t, q[k], v[k], ftable, findex, ftimes, fvalues, f)
@@ -745,19 +850,37 @@ def end_of_step(k, status, counters):
 
 @jit
 def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
-    """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call."""
-    f = np.empty(model[0].shape[0])
-    scratch = step_scratch(solver_code, model)
-    weight, ftable, findex, ftimes, fvalues, q, v = model[1], model[4], model[5], model[6], model[7], out[0], out[1]
-    counters = out[9]
+    """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call,
+    on the tuples' arrays unpacked here once (run_arrays)."""
+    # what the loop needs besides the tuples, allocated here: run_arrays counts no references
+    f, ring = np.empty(model.minv.shape[0]), np.empty((3, 3, model.contacts.shape[0]))
+    return run_arrays(solver_code, k_start, k_end, params, iparams, extra, step_scratch(solver_code, model), f, ring,
+                      np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64),
+                      model.minv, model.weight, model.contacts, model.contact_index, model.force_table,
+                      model.force_index, model.force_times, model.force_values, model.disks, model.disk_body,
+                      model.pair_keys, model.pair_contact, model.motions, model.motion_times, model.motion_values,
+                      model.motion_now, model.driven, model.driven_origin, model.joints, work.gaps, work.drifts,
+                      work.hn, work.ht, work.active, work.was_closed, work.grazing, work.slip_sign, work.v_free,
+                      work.a_free, work.candidate, work.joint_buffer, out.q, out.v, out.p_normal, out.p_tangent,
+                      out.slip, out.states, out.impact_t, out.impact_step, out.impact_contact, out.counters,
+                      out.joint_impulse)
+
+
+@jit_borrowing
+def run_arrays(solver_code, k_start, k_end, params, iparams, extra, scratch, f, memory, before,
+               minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys,
+               pair_contact, motions, motion_times, motion_values, motion_now, driven, driven_origin, joints,
+               gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, joint_buffer,
+               q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step, impact_contact, counters,
+               joint_impulse):
+    """The loop over the steps, on Model's, Work's and Records' arrays in their order; f: the
+    force's array, memory and before: the rest's ring (below)."""
+    s_floats, s_states, s_w, s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats = scratch
     # The contacts' memory after each of the last three steps and the solver's counters before
-    # them (a ring by step): what _fixed_period compares.
-    memory = np.empty((3, 3, model[2].shape[0]))
-    before = np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64)
-    k = k_start
-    # the ring's bookkeeping only where a rest can be repeated (not for a time-varying scene, nor the
-    # one-step calls of the step-wise loop)
+    # them (a ring by step): what _fixed_period compares — only where a rest can be repeated (not
+    # a time-varying scene, nor the one-step calls of the step-wise loop).
     repeats = iparams[I_TIME_INVARIANT] != 0 and k_end - k_start > 2
+    k = k_start
     while k < k_end:
         if repeats:
             for c in range(len(REPEATED_COUNTERS)):
@@ -765,20 +888,28 @@ def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
         _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f)
         for d in range(extra.shape[0]):
             f[d] += extra[d]
-        if end_of_step(k, _step(solver_code, k, f, params, iparams, model, work, out, scratch), counters) != RUN_OK:
+        status = step_arrays(
+            solver_code, k, f, params, iparams, minv, weight, table, index, ftable, findex, ftimes, fvalues, disks,
+            disk_body, pair_keys, pair_contact, motions, motion_times, motion_values, motion_now, driven,
+            driven_origin, joints, gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free,
+            candidate, joint_buffer, q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step,
+            impact_contact, counters, joint_impulse, s_floats, s_states, s_w, s_solver_floats, s_solver_ints,
+            s_sparse_ints, s_sparse_floats)
+        if end_of_step(k, status, counters) != RUN_OK:
             return counters[K_STATUS]
         if repeats:
             for i in range(memory.shape[2]):
-                memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = work[5][i], work[6][i], work[7][i]
-            period = _fixed_period(k, k - k_start + 1, out, memory) if k + 1 < k_end else 0
+                memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = was_closed[i], grazing[i], slip_sign[i]
+            period = _fixed_period(k, k - k_start + 1, q, v, p_normal, p_tangent, memory) if k + 1 < k_end else 0
             if period > 0:
-                k = _repeat_period(k, k_end, period, out, work, memory, before)
+                k = _repeat_period(k, k_end, period, q, v, p_normal, p_tangent, slip, state_rec, joint_impulse,
+                                   counters, was_closed, grazing, slip_sign, memory, before)
         k += 1
     return RUN_OK
 
 
 @jit
-def _fixed_period(k, steps_here, out, memory):
+def _fixed_period(k, steps_here, q, v, p_normal, p_tangent, memory):
     """1 or 2 when the state step k leaves — q, v, the contacts' memory and the impulses the next
     step warm-starts from — is the one left by step k − 1 (a rest) or k − 2 (a two-step cycle of
     round-off, as a held body's v alternating between two values of 1e-18); else 0.
@@ -786,7 +917,6 @@ def _fixed_period(k, steps_here, out, memory):
     The step map is a function of that state, the same at every t when iparams[I_TIME_INVARIANT]
     (no force that changes with time alone): every later step then repeats one of the last
     `period` steps bit for bit. Exact holds (no creep) reach such a state within a few steps."""
-    q, v, p_normal, p_tangent = out[0], out[1], out[2], out[3]
     for period in range(1, 3):
         if steps_here <= period:
             return 0
@@ -810,18 +940,18 @@ def _fixed_period(k, steps_here, out, memory):
 
 
 @jit
-def _repeat_period(k, k_end, period, out, work, memory, before):
+def _repeat_period(k, k_end, period, q, v, p_normal, p_tangent, slip, state_rec, joint_impulse, counters, was_closed,
+                   grazing, slip_sign, memory, before):
     """Rows k + 1 … k_end − 1 as the step `period` rows before each made them (state, records,
     the solver's counters, the memory left at the end); returns the last step so filled."""
-    counters = out[9]
     for r in range(k + 1, k_end):
-        out[0][r + 1, :] = out[0][r + 1 - period]
-        out[1][r + 1, :] = out[1][r + 1 - period]
-        out[2][r, :] = out[2][r - period]  # impulses, slips, states (a tuple: literal indices)
-        out[3][r, :] = out[3][r - period]
-        out[4][r, :] = out[4][r - period]
-        out[5][r, :] = out[5][r - period]
-        out[O_JOINT_IMPULSE][r, :] = out[O_JOINT_IMPULSE][r - period]
+        q[r + 1, :] = q[r + 1 - period]
+        v[r + 1, :] = v[r + 1 - period]
+        p_normal[r, :] = p_normal[r - period]
+        p_tangent[r, :] = p_tangent[r - period]
+        slip[r, :] = slip[r - period]
+        state_rec[r, :] = state_rec[r - period]
+        joint_impulse[r, :] = joint_impulse[r - period]
     for c in range(len(REPEATED_COUNTERS)):
         added = 0
         for j in range(k + 1 - period, k + 1):  # each repeated step adds what its original added
@@ -832,7 +962,7 @@ def _repeat_period(k, k_end, period, out, work, memory, before):
     last = k_end - 1
     src = k - ((k - last) % period)  # the step of the last period that `last` repeats
     for i in range(memory.shape[2]):  # the memory the last filled step leaves: its original's
-        work[5][i], work[6][i], work[7][i] = memory[src % 3, 0, i], memory[src % 3, 1, i], memory[src % 3, 2, i]
+        was_closed[i], grazing[i], slip_sign[i] = memory[src % 3, 0, i], memory[src % 3, 1, i], memory[src % 3, 2, i]
     counters[K_REPEATED] += last - k
     counters[K_DONE] = k_end
     return last
@@ -853,7 +983,6 @@ def run_steps(k_start, k_end, params, iparams, model, work, out, extra):
     return _run(iparams[I_SOLVER], k_start, k_end, params, iparams, model, work, out, extra)
 
 
-__all__ = ["begin_step", "assemble", "solve_step", "step_scratch", "geometry_failure", "finish_step", "step_force", "run_steps",
-           "drive_step", "hold_driven_velocities", "place_driven_bodies",
-           "crossing_offset", "ACTIVATION_ROUNDOFF"]
-
+__all__ = ["Model", "Work", "Records", "Scratch", "begin_step", "assemble", "solve_arrays", "step_scratch",
+           "geometry_failure", "finish_step", "step_force", "run_steps", "drive_step", "hold_driven_velocities",
+           "place_driven_bodies", "crossing_offset", "ACTIVATION_ROUNDOFF"]

@@ -130,11 +130,7 @@ class Window:
     def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0):
         rows = HISTORY + chunk
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
-        self.out = (np.empty((rows + 1, n_dof)), np.empty((rows + 1, n_dof)), np.zeros((rows, n_contacts)),
-                    np.zeros((rows, n_contacts)), np.zeros((rows, n_contacts)),
-                    np.zeros((rows, n_contacts), dtype=np.int64), np.zeros(capacity),
-                    np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
-                    np.zeros(loop.N_COUNTERS, dtype=np.int64), np.zeros((rows, joint_rows)))
+        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows)
         self.rows, self.k_base, self.r = rows, 0, 0
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:

@@ -195,5 +195,18 @@ def local_dot(h_row, index, i, x):
     return s
 
 
-__all__ = ["PackedScene", "pack_scene", "pack_contacts", "contact_kinematics", "local_dot",
+@jit
+def row_dot(rows, index, i, x):
+    """local_dot of contact i's row of `rows` (n_contacts × 6), without a view of the row: the
+    per-step kernels call it for every contact (a row view costs a reference count)."""
+    j = 3 * index[i, CI_BODY_A]
+    s = rows[i, 0] * x[j] + rows[i, 1] * x[j + 1] + rows[i, 2] * x[j + 2]
+    b = index[i, CI_BODY_B]
+    if b >= 0:
+        j = 3 * b
+        s += rows[i, 3] * x[j] + rows[i, 4] * x[j + 1] + rows[i, 5] * x[j + 2]
+    return s
+
+
+__all__ = ["PackedScene", "pack_scene", "pack_contacts", "contact_kinematics", "local_dot", "row_dot",
            "KIND_DISK_ON_LINE", "KIND_DISK_ON_DISK", "KIND_DISK_ON_SEGMENT"]
