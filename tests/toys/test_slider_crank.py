@@ -64,3 +64,14 @@ def test_friction_in_the_guide_takes_energy_from_the_mechanism():
 def test_bad_parameters_are_refused_naming_the_field(field, value):
     with pytest.raises(nr.InputError, match=field):
         SliderCrank(**{field: value})
+
+
+def test_the_example_scene_file_is_the_toy_with_clearance():
+    from pathlib import Path
+
+    sf = nr.load_scene(Path(__file__).resolve().parents[2] / "examples" / "scenes" / "slider_crank.toml")
+    toy = SliderCrank(clearance=1e-3, mu=0.1)
+    q0, v0 = toy.initial_state()
+    assert sf.q0 == pytest.approx(q0, abs=1e-14) and sf.v0 == pytest.approx(v0, abs=1e-12)
+    from_file = nr.simulate(sf.scene, sf.q0, sf.v0, 0.05, "moreau-jean", h=H)
+    assert np.max(np.abs(from_file.q - _run(toy, 0.05).q)) < 1e-12

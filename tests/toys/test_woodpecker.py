@@ -93,3 +93,16 @@ def test_the_jam_angle_is_where_the_lower_edge_meets_the_pole():
 def test_bad_parameters_are_refused_naming_the_field(field, value):
     with pytest.raises(nr.InputError, match=field):
         Woodpecker(**{field: value})
+
+
+def test_the_example_scene_file_is_the_toy():
+    from pathlib import Path
+
+    sf = nr.load_scene(Path(__file__).resolve().parents[2] / "examples" / "scenes" / "woodpecker.toml")
+    toy = Woodpecker()
+    q0, v0 = toy.initial_state()
+    assert sf.q0 == pytest.approx(q0, abs=1e-15) and sf.v0 == pytest.approx(v0, abs=1e-15)
+    from_file = nr.simulate(sf.scene, sf.q0, sf.v0, 0.1, "moreau-jean", h=H)
+    from_toy = nr.simulate(toy.scene(), q0, v0, 0.1, "moreau-jean", h=H)
+    assert from_file.contact_names == from_toy.contact_names == ["beak", "lower", "upper"]
+    assert np.max(np.abs(from_file.q - from_toy.q)) < 1e-12
