@@ -28,8 +28,8 @@ in φ). This toy is its planar rigid-body version with the exact geometry:
 What differs from the published (linearised) model is second order in the angles, but the bird
 swings to |φ_S| ≈ 0.5 rad: gravity's moment m_S g l_G cos φ_S and the bird's vertical lever
 l_G cos φ_S are 12 % below the linearised ones there, and the sleeve jams at 0.1009 rad instead
-of (r_M − r_O)/h_M = 0.1034 rad. The limit cycle's period is 10 % shorter and the sleeve never
-reaches its upper jam after the beak's impact (docs/joints.md, "The woodpecker toy";
+of (r_M − r_O)/h_M = 0.1034 rad. The limit cycle's period is 11 % shorter and the sleeve never
+reaches its upper jam after the beak's impact (docs/joints.md, "Glocker's woodpecker toy";
 `toys.woodpecker_reduced` integrates both three-coordinate models independently).
 """
 from __future__ import annotations
