@@ -43,7 +43,7 @@ def test_the_toy_limit_cycle_is_the_exact_geometry_model_s(toy_cycle):
     result, cycle = toy_cycle
     reference = _reduced_cycle(linear=False)
     assert len(cycle.periods) == len(reference.periods) == 2
-    # two first-order schemes at one step: 0.5 to 0.8 % apart in period (each 0.4 % from its h → 0)
+    # two first-order schemes at one step: 0.4 to 0.8 % apart in period (each within 0.5 % of its h → 0)
     assert cycle.periods == pytest.approx(reference.periods, rel=1.5e-2)
     assert cycle.descents == pytest.approx(reference.descents, rel=6e-2)  # 2 to 4 % apart
     assert cycle.sequences == reference.sequences == [["beak", "lower", "lower"]] * 2
