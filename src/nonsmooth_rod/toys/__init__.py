@@ -29,10 +29,13 @@ from .indeterminate import DiskPyramid, Ladder, WedgedRod
 from .painleve import PainleveRod
 from .rocking_block import RockingBlock, impact_rate_pairs
 from .shaken import BallOnShakenPlate, ShakenBlock
+from .slider_crank import SliderCrank, wall_switches
+from .woodpecker import LimitCycle, Woodpecker, limit_cycle
 
 __all__ = [
     "run", "BouncingBall", "BlockOnIncline", "PushedBlock", "DiskOnIncline", "BeltOscillator",
     "RockingBlock", "PainleveRod", "BallRow", "ball_height", "rest_time", "slope_motion",
     "first_slip_time", "stick_slip_phases", "impact_rate_pairs", "ball_velocities", "save_figure",
     "example_parser", "Ladder", "WedgedRod", "DiskPyramid", "ShakenBlock", "BallOnShakenPlate",
+    "Woodpecker", "LimitCycle", "limit_cycle", "SliderCrank", "wall_switches",
 ]

@@ -1,0 +1,22 @@
+"""benchmarks/bench_woodpecker.py --quick prints the toy's cycle next to Siconos' and the
+three-coordinate models' (the numbers themselves are tested in tests/toys/test_woodpecker.py)."""
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_woodpecker.py"
+
+
+def test_bench_woodpecker_quick(capsys):
+    spec = importlib.util.spec_from_file_location("bench_woodpecker", BENCH)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    periods = [float(p) for p in re.findall(r"period ([0-9.]+) s", out)]
+    assert len(periods) == 4
+    siconos, toy, linearised, exact = periods
+    assert abs(linearised - siconos) < 1e-3 and abs(toy - exact) < 2e-3 and exact < 0.95 * siconos
+    assert "cycle beak upper lower lower upper" in out and "cycle beak lower lower" in out
