@@ -12,6 +12,7 @@ import pytest
 from nonsmooth_rod.studies import maps, patching
 from nonsmooth_rod.studies.maps import run_point, scene_data, sweep
 from nonsmooth_rod.studies.patching import PointScenes
+from nonsmooth_rod.studies.paths import with_values
 
 SCENES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 FLOOR, WALL = "contacts.foot.law.mu_s", "contacts.top.law.mu_s"
@@ -43,6 +44,8 @@ def test_patched_laws_run_the_ladder_as_the_full_parse_does(ladder):
     pairs = rows_both_ways(data, source, names, (FLOOR, WALL), points)
     for fast, slow in pairs:
         assert same_row(fast, slow), (fast, slow)
+    point = {FLOOR: 0.3, WALL: 0.1}
+    assert PointScenes(data, source, (FLOOR, WALL)).scene_file(point).data == with_values(data, point)
     # and they are the physics: the ladder slides below the critical floor μs, holds above it
     assert [bool(f["held"]) for f, _ in pairs] == [False, False, True, True]
 

@@ -117,6 +117,9 @@ def pack_disk_pairs(table, index):
             ends.append(disk_id[disk])
         keys.append(ends)
         owners.append(i)
+    if not keys:  # contacts on lines only (most small scenes): no broad phase
+        empty = np.zeros(0, dtype=np.int64)
+        return np.zeros((0, 3)), empty, empty.copy(), empty.copy()
     n = len(disks)
     flat = np.array([min(a, b) * n + max(a, b) for a, b in keys], dtype=np.int64)
     order = np.argsort(flat, kind="stable")

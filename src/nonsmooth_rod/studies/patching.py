@@ -7,8 +7,10 @@ only the sections its paths touch and parses those again with scenefile's own fu
 copy of the base SceneFile:
 
 * a contact's law (`contacts.NAME.law.mu_s`, `mu_d`, `restitution`; `*` for every contact):
-  every declared contact's law is read again (`_law`: the same defaults — μd = μs when the file
-  leaves it out — and checks), a changed one in a copy of its relation;
+  the law table of each contact a path names, copied and patched, is read again (`_law`: the
+  same defaults — μd = μs when the file leaves it out — and checks) into a copy of its relation,
+  kept by its law table for the points that repeat it (the values along one axis repeat at every
+  value of the others);
 * the initial state (`initial.*`): `_initial`, then the overlap and joint checks on it;
 * the run's settings (`simulation.*`: t_end, h, ...): `_simulation`.
 
@@ -22,10 +24,9 @@ from __future__ import annotations
 import copy
 import dataclasses
 
-from ..scenefile import (_check_joints_hold, _check_overlap, _initial, _items, _law, _simulation, _Where,
-                         parse_scene)
+from ..scenefile import _check_joints_hold, _check_overlap, _initial, _law, _simulation, _Where, parse_scene
 from ..validation import InputError
-from .paths import set_value, with_values
+from .paths import _slots, set_value, with_values
 
 PATCHED_LAW_KEYS = ("mu_s", "mu_d", "restitution")
 PATCHED_SECTIONS = ("contacts", "initial", "simulation")  # the order parse_scene reads them in
@@ -50,8 +51,13 @@ class PointScenes:
         sections = {p.split(".")[0] for p in single}
         self.fast = bool(fast) and all(map(patchable, single)) and all(isinstance(data.get(s), (dict, list))
                                                                         for s in sections)
-        self.sections = [s for s in PATCHED_SECTIONS if s in sections]
+        self.sections = [s for s in PATCHED_SECTIONS if s in sections and s != "contacts"]
+        try:
+            self.law_slots = _law_slots(data, [p for p in single if p.startswith("contacts.")]) if self.fast else {}
+        except InputError:  # a path the full parse refuses, point by point
+            self.fast, self.law_slots = False, {}
         self.base = parse_scene(data, source) if self.fast else None
+        self._relations: dict = {}  # (contact, its law table) -> the relation with that law
 
     def scene_file(self, values: dict):
         """The scene at a point ({axis key: value}); an InputError (from the full parse) if the
@@ -67,13 +73,19 @@ class PointScenes:
         data = dict(self.data)  # the sections a path touches copied; the rest shared with the base
         for section in self.sections:
             data[section] = copy.deepcopy(self.data[section])
+        laws = {i: dict(self.data["contacts"][i]["law"]) for i in {i for s in self.law_slots.values() for i, _ in s}}
         for keys, value in values.items():
             for path in keys.split(","):
-                set_value(data, path.strip(), value)
+                path = path.strip()
+                if path in self.law_slots:
+                    for i, key in self.law_slots[path]:
+                        laws[i][key] = float(value)
+                else:
+                    set_value(data, path, value)
         base, w = self.base, _Where(self.source)
         changes = {"data": data}
-        if "contacts" in self.sections:
-            changes["scene"] = _with_laws(w, base.scene, data)
+        if laws:
+            changes["scene"] = self._with_laws(w, data, laws)
         if "initial" in self.sections:
             scene = changes.get("scene", base.scene)
             q0, v0 = _initial(w, data, base.body_names)
@@ -85,18 +97,41 @@ class PointScenes:
             changes.update(method=method, t_end=t_end, options=options, stop=stop, save_every=save_every)
         return dataclasses.replace(base, **changes)
 
+    def _with_laws(self, w, data: dict, laws: dict):
+        """A copy of the base scene whose declared contacts i carry the law tables laws[i] (read
+        by scenefile's `_law`: its defaults and checks); `data` gets those tables too."""
+        scene, tables = copy.copy(self.base.scene), list(data["contacts"])
+        scene.contacts = list(scene.contacts)
+        for i, law_table in laws.items():
+            tables[i] = {**tables[i], "law": law_table}
+            key = (i, tuple((k, type(v), repr(v)) for k, v in law_table.items()))  # -0.0 is not 0.0
+            relation = self._relations.get(key)
+            if relation is None:
+                relation = copy.copy(scene.contacts[i])
+                relation.law = _law(w, tables[i], f"contacts.{tables[i]['name']}")
+                if len(self._relations) >= MAX_RELATIONS:
+                    self._relations.clear()
+                self._relations[key] = relation
+            scene.contacts[i] = relation  # runs never change a relation: points may share it
+        data["contacts"] = tables
+        return scene
 
-def _with_laws(w, scene, data):
-    """A copy of `scene` whose declared contacts carry the laws `data` gives them (the contacts
-    found between shapes come after the declared ones, in parse_scene's order, unchanged)."""
-    contacts = list(scene.contacts)
-    for i, (name, table) in enumerate(_items(w, data, "contacts")):
-        law = _law(w, table, f"contacts.{name}")
-        if law != contacts[i].law:
-            contacts[i] = copy.copy(contacts[i])
-            contacts[i].law = law
-    out = copy.copy(scene)
-    out.contacts = contacts
+
+MAX_RELATIONS = 4096  # relations kept by law (a map's axis values repeat along the other axes)
+
+
+def _law_slots(data: dict, paths) -> dict:
+    """{path: [(declared contact index, law key)]} of contact-law paths (`*` names several)."""
+    tables = data.get("contacts")
+    out = {}
+    for path in paths:
+        slots = []
+        for node, key in _slots(data, path):
+            where = [i for i, t in enumerate(tables) if isinstance(t, dict) and t.get("law") is node]
+            if len(where) != 1:
+                raise InputError(f"{path}: not a contact's law")  # (checked before a map starts)
+            slots.append((where[0], key))
+        out[path] = slots
     return out
 
 
