@@ -1,6 +1,7 @@
 """Microseconds per Moreau–Jean step on every kind of scene, and the engine's cold compile time.
 
     python benchmarks/bench_scenes.py [--quick] [--repeats 5] [--no-compile-time] [--max-balls 256] [--only NAME]
+    python benchmarks/bench_scenes.py --fixed-cost [--repeats 300]    # the fixed cost of a call alone
 
 Scenes: the paper's rod, each toy, a frictionless ladder (2 contacts, 1 body), a row of N balls
 on a floor (N − 1 disk–disk and N disk–floor contacts, the first ball rolling into the others),
@@ -127,6 +128,21 @@ def targets(repeats: int, quick: bool) -> None:
                   f"{'' if run.status == 'ok' else '  ' + run.status}")
 
 
+def fixed_cost(repeats: int) -> None:
+    """Issue 25's fixed cost of a call: 50-step one-body runs through nr.simulate, the whole call
+    against its loop (`result.cpu_time_s`), and the part outside the loop in yardsticks (target
+    ≤ 10); CPU time, medians of `repeats` calls after a few warm ones."""
+    print(f"{'fixed cost, 50 steps':28s} {'whole x yd':>10s} {'loop x yd':>9s} {'outside x yd':>12s} "
+          f"{'whole/loop':>10s}")
+    for name in ONE_CONTACT + ("BlockOnIncline",):
+        toy = getattr(toys, name)()
+        scene, (q0, v0) = toy.scene(), toy.initial_state()
+        whole, loop, _ = step_us(scene, q0, v0, "lemke", 1e-3, 50, repeats)
+        yard = yardstick_us(n=5000, repeats=3)
+        print(f"toy {name:24s} {whole * 50 / yard:10.1f} {loop * 50 / yard:9.1f} {(whole - loop) * 50 / yard:12.1f} "
+              f"{whole / loop:10.2f}")
+
+
 def cold_compile_seconds() -> float:
     """Wall time of a fresh process with an empty numba cache running one short rod run, minus
     the same process with a warm cache (imports and the run itself)."""
@@ -175,7 +191,12 @@ def main(argv=None) -> int:
     parser.add_argument("--no-compile-time", action="store_true")
     parser.add_argument("--only", default="", help="run only the scenes whose name contains this")
     parser.add_argument("--plot", default=None, metavar="PNG", help="log–log plot of cost per step against N (rows)")
+    parser.add_argument("--fixed-cost", action="store_true",
+                        help="only the fixed cost of a call: 50-step one-body runs, whole against loop")
     args = parser.parse_args(argv)
+    if args.fixed_cost:
+        fixed_cost(max(args.repeats, 100))
+        return 0
     rows_cost = {}  # engine/solver → [(N balls, yardsticks per step)] for the ball rows
     repeats = 2 if args.quick else args.repeats
     max_balls = args.max_balls or (32 if args.quick else 256)

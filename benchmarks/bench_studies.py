@@ -1,6 +1,7 @@
 """Studies of any scene: a map's cost per point, and the fit's coverage on synthetic data.
 
-    PYTHONPATH=src python benchmarks/bench_studies.py [--quick] [--jobs 2] [--repeats 100] [--out FILE.json]
+    PYTHONPATH=src python benchmarks/bench_studies.py [--quick] [--jobs 2] [--repeats 100] [--skip-map]
+                                                      [--skip-fit] [--skip-posterior] [--out FILE.json]
 
 1. Maps: the ladder (examples/scenes/ladder.toml) over (floor μs, wall μs), N × N points
    (N = 100: 10⁴ runs; --quick: N = 20), with `jobs` workers: wall time, points/s and points/s
@@ -10,11 +11,17 @@
    the stated sigma (2 ms and 1 ms), fitted from (0.275, 0.15) `repeats` times (--quick: 20):
    the fraction of repeats whose estimate lies within 1 and 2 standard uncertainties of the
    truth, for each key, against 68.3 % and 95.4 % (the rate a linear model predicts).
+3. Posterior (MCMC, emcee): the bouncing ball's restitution e from its two impact times (the
+   second measured 1.5 ms late, σ = 2 ms). t2 = t1 (1 + 2e) is linear in e, so the posterior
+   (flat prior) is the Gaussian of mean (t2/t1 − 1)/2 and sd σ/(2 t1): the chain's mean and sd
+   against it, its acceptance and autocorrelation, runs per second (16 walkers × 600 steps;
+   --quick: 6 × 40).
 """
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import tempfile
@@ -77,6 +84,29 @@ def coverage(repeats: int, seed: int = 2024) -> dict:
     return out
 
 
+BALL = SCENES / "bouncing_ball.toml"
+BALL_SETS = ["simulation.t_end=0.95", "simulation.event-driven.rtol=1e-8", "simulation.event-driven.atol=1e-8"]
+BALL_SIGMA, BALL_LATE = 2e-3, 1.5e-3
+
+
+def restitution_posterior(walkers: int, steps: int, seed: int = 1) -> dict:
+    """The ball's e by MCMC from its impact times, against the closed-form Gaussian posterior."""
+    t1 = math.sqrt(2 * 1.0 / 9.81)  # dropped from 1 m (examples/scenes/bouncing_ball.toml)
+    t2 = t1 * (1 + 2 * 0.5) + BALL_LATE
+    measured = Measurements(events=[{"kind": "impact", "contact": "floor", "t": t1, "sigma": BALL_SIGMA},
+                                    {"kind": "impact", "contact": "floor", "t": t2, "sigma": BALL_SIGMA}])
+    started = time.perf_counter()
+    r = fit(BALL, measured, ["contacts.floor.law.restitution"], sets=BALL_SETS, method="event-driven",
+            posterior=True, walkers=walkers, posterior_steps=steps, seed=seed)
+    seconds = time.perf_counter() - started
+    post = r.posterior
+    return {"walkers": walkers, "steps": steps, "seconds": seconds, "runs_per_s": post.evaluations / seconds,
+            "closed_form_mean": (t2 / t1 - 1) / 2, "closed_form_sd": BALL_SIGMA / (2 * t1),
+            "estimate": float(r.estimate[0]), "jacobian_sd": float(r.uncertainty[0]),
+            "posterior_mean": float(post.mean[0]), "posterior_sd": float(post.sd[0]), "acceptance": post.acceptance,
+            "autocorrelation_steps": float(post.autocorrelation[0]), "samples": int(post.samples.shape[0])}
+
+
 def map_rate(n: int, jobs: int) -> dict:
     """The ladder's n × n map: wall time and points/s (per core)."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -95,6 +125,8 @@ def main(argv=None) -> dict:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=None, help="fits (default 100, --quick 20)")
     ap.add_argument("--skip-map", action="store_true")
+    ap.add_argument("--skip-fit", action="store_true")
+    ap.add_argument("--skip-posterior", action="store_true")
     ap.add_argument("--out", default=None, help="write the report as JSON")
     args = ap.parse_args(argv)
     repeats = args.repeats or (20 if args.quick else 100)
@@ -104,11 +136,19 @@ def main(argv=None) -> dict:
         m = report["map"]
         print(f"map of the ladder: {m['points']} points, {m['wall_s']:.2f} s wall, {m['points_per_s']:,.0f} points/s "
               f"on {m['jobs']} workers ({m['points_per_s_per_core']:,.0f} per core)")
-    report["fit"] = c = coverage(repeats)
-    print(f"fit of the rod: {repeats} repeats, {c['seconds_per_fit']:.2f} s per fit")
-    for p in TRUTH:
-        print(f"  {p}: within 1σ {c[p]['within_1_sigma']}/{repeats} (68.3 % expected), within 2σ "
-              f"{c[p]['within_2_sigma']}/{repeats} (95.4 %)")
+    if not args.skip_fit:
+        report["fit"] = c = coverage(repeats)
+        print(f"fit of the rod: {repeats} repeats, {c['seconds_per_fit']:.2f} s per fit")
+        for p in TRUTH:
+            print(f"  {p}: within 1σ {c[p]['within_1_sigma']}/{repeats} (68.3 % expected), within 2σ "
+                  f"{c[p]['within_2_sigma']}/{repeats} (95.4 %)")
+    if not args.skip_posterior:
+        report["posterior"] = m = restitution_posterior(*((6, 40) if args.quick else (16, 600)))
+        print(f"posterior of the ball's e: {m['walkers']} walkers × {m['steps']} steps, {m['seconds']:.1f} s "
+              f"({m['runs_per_s']:.0f} runs/s), acceptance {m['acceptance']:.2f}, autocorrelation "
+              f"{m['autocorrelation_steps']:.3g} steps\n  mean {m['posterior_mean']:.5f} "
+              f"sd {m['posterior_sd']:.5f} (closed form {m['closed_form_mean']:.5f}, {m['closed_form_sd']:.5f}; "
+              f"Jacobian sd {m['jacobian_sd']:.5f})")
     if args.out:
         Path(args.out).write_text(json.dumps(report, indent=1, default=str))
     return report

@@ -8,6 +8,7 @@ the compiled loop — can trust their inputs.
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import re
@@ -143,7 +144,41 @@ def _stop_conditions(stop, scene: Scene):
     return impacts, callables
 
 
+# Checked options by what they were built from (the class and each value with its type: 1 and
+# True, 0.0 and -0.0 are different options): a study's thousands of runs with the same options
+# check them once.
+_CHECKED_OPTIONS: dict = {}
+MAX_CHECKED_OPTIONS = 256
+
+
+def _frozen(value):
+    """A hashable key of an option's value and its type (dicts and lists by their items)."""
+    if isinstance(value, dict):
+        return dict, tuple((k, _frozen(v)) for k, v in value.items())
+    if isinstance(value, (list, tuple)):
+        return type(value), tuple(_frozen(v) for v in value)
+    if isinstance(value, float):  # by its digits: -0.0 is not 0.0 here
+        return type(value), repr(value)
+    return type(value), value
+
+
 def _options(options_cls, method: str, options: dict, impact_stops: list):
+    """The method's options object: checked on first use, a copy of the checked one after."""
+    try:
+        key = (options_cls, _frozen(options), tuple(impact_stops))
+        checked = _CHECKED_OPTIONS.get(key)
+    except TypeError:  # an unhashable value (an array): checked every time
+        key, checked = None, None
+    if checked is None:
+        checked = _checked_options(options_cls, method, options, impact_stops)
+        if key is not None:
+            if len(_CHECKED_OPTIONS) >= MAX_CHECKED_OPTIONS:
+                _CHECKED_OPTIONS.clear()
+            _CHECKED_OPTIONS[key] = checked
+    return copy.copy(checked)  # the run's own: nothing a run does reaches the cached one
+
+
+def _checked_options(options_cls, method: str, options: dict, impact_stops: list):
     valid = [f.name for f in dataclasses.fields(options_cls) if f.name != "stop_at_impact"]
     for key in options:
         if key not in valid:

@@ -196,6 +196,43 @@ class SimulationResult:
         self.status = Status(status)
         self.message = message
 
+    def defer(self, locate) -> None:
+        """Leave `phases` and `events` to `locate(result)`, which sets both, run when either is
+        first read or set (a study that reads the final state alone never locates phases)."""
+        self.__dict__["_locate"] = locate
+
+    def _settle(self) -> None:
+        locate = self.__dict__.pop("_locate", None)
+        if locate is not None:
+            locate(self)
+
+    def __getstate__(self):  # pickled (a sweep's worker) with its phases located, not the closure
+        self._settle()
+        return self.__dict__
+
+
+class _Deferred:
+    """A SimulationResult field that `defer` may leave to be computed on first use."""
+
+    def __set_name__(self, owner, name):
+        self.slot = "_" + name
+
+    def __get__(self, result, owner=None):
+        if result is None:
+            return self
+        result._settle()
+        return result.__dict__[self.slot]
+
+    def __set__(self, result, value):
+        result._settle()
+        result.__dict__[self.slot] = value
+
+
+for _name in ("events", "phases"):  # after @dataclass: its __init__ assigns them through these
+    _field = _Deferred()
+    _field.__set_name__(SimulationResult, _name)
+    setattr(SimulationResult, _name, _field)
+
 
 def phases_from_intervals(t_bounds, modes, min_duration: float = 0.0) -> list[Phase]:
     """Contiguous phases from per-interval modes: modes[i] holds on [t_bounds[i], t_bounds[i+1]].

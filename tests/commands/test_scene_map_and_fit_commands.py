@@ -46,6 +46,25 @@ def test_fit_prints_json_and_writes_its_files(tmp_path, capsys):
     assert (tmp_path / "f" / "fit.json").exists() and (tmp_path / "f" / "fit.png").exists()
 
 
+def test_fit_with_a_posterior_writes_the_chain_summary(tmp_path, capsys):
+    pytest.importorskip("emcee")
+    ball = str(SCENES / "bouncing_ball.toml")
+    events = ('[[events]]\nkind = "impact"\ncontact = "floor"\nt = 0.4515\nsigma = 0.002\n'
+              '[[events]]\nkind = "impact"\ncontact = "floor"\nt = 0.9045\nsigma = 0.002\n')
+    code = main(["fit", ball, "--measured", _events(tmp_path, events), "--free", "contacts.floor.law.restitution",
+                 "--set", "simulation.t_end=0.95", "--posterior", "--walkers", "4", "--posterior-steps", "8",
+                 "--out", str(tmp_path / "f"), "--json", "--no-plot"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    post = summary["posterior"]
+    assert post["walkers"] == 4 and post["steps"] == 8 and post["samples"] == 4 * (8 - 2)
+    key = post["free"][0]
+    assert key["path"] == "contacts.floor.law.restitution" and 0 <= key["q16"] <= key["median"] <= key["q84"] <= 1
+    # t2 = t1 (1 + 2e): the estimate (0.5016) and the chain (walkers within a few of its sd) agree
+    assert abs(key["mean"] - summary["free"][0]["estimate"]) < 3 * summary["free"][0]["uncertainty"]
+    assert json.loads((tmp_path / "f" / "fit.json").read_text())["posterior"]["walkers"] == 4
+
+
 BAD_SWEEPS = [
     (["--axis", "contacts.nothing.law.mu_s=0.1:0.2:3"], "no entry named 'nothing'"),
     (["--axis", "title=1,2"], "not a number"),
@@ -121,6 +140,8 @@ BAD_FREE = [
     (["--free", "title"], "not a number"),
     (["--free", "contacts.A.law.mu_s=0.5:0.1"], "LO < HI"),
     ([], "name at least one scene key"),
+    (["--free", "contacts.A.law.mu_d", "--posterior", "--walkers", "3"], "walkers must be an even number"),
+    (["--free", "contacts.A.law.mu_d", "--posterior", "--posterior-steps", "1"], "steps must be at least 2"),
 ]
 
 

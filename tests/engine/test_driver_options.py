@@ -93,6 +93,20 @@ def test_checked_values_are_what_the_run_uses():
     assert type(opts.solver_options["max_iter"]) is int
 
 
+def test_options_checked_once_are_still_checked_by_type_and_value():
+    """The driver keeps the options it checked (a study's runs share them): a value equal to a
+    checked one but of another type (1 for True, 1 for 1.0 in a table) is checked afresh."""
+    scene, q0, v0 = dropped_ball()
+    for _ in range(2):
+        run = nr.simulate(scene, q0, v0, 0.05, h=1e-3, repeat_rest=True, solver_options={"tol": 1e-12})
+        assert run.status == "ok" and run.stats["h"] == 1e-3 and run.stats["steps"] == 50
+    assert "repeat_rest must be true or false, got 1" in refusal("moreau-jean", h=1e-3, repeat_rest=1,
+                                                                 solver_options={"tol": 1e-12})
+    assert "h (step size) must be a number, got True" in refusal("moreau-jean", h=True)
+    # another step: another run (the checked options are copied, never shared between runs)
+    assert nr.simulate(scene, q0, v0, 0.05, h=1e-2, repeat_rest=True, solver_options={"tol": 1e-12}).steps == 5
+
+
 @pytest.mark.parametrize("method", [["moreau-jean"], 7, None])
 def test_a_method_that_is_not_a_name(method):
     assert "unknown method" in refusal(method)

@@ -46,3 +46,14 @@ def test_bench_scenes_targets_quick_print_every_case(capsys):
     for row in rows:
         whole, target, whole_over_loop = float(row[-3]), float(row[-2]), float(row[-1])
         assert whole > 0 and target in (0.2, 0.3, 0.4) and whole_over_loop >= 1.0  # the call contains its loop
+
+
+def test_bench_scenes_fixed_cost_prints_every_one_body_scene(capsys):
+    module = _bench_scenes()
+    assert module.main(["--fixed-cost"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert [row[1] for row in rows] == list(module.ONE_CONTACT) + ["BlockOnIncline"]
+    for row in rows:
+        whole, loop, outside, ratio = map(float, row[-4:])
+        assert whole >= loop > 0 and ratio >= 1.0  # the call contains its loop
+        assert abs(whole - loop - outside) <= 0.15  # the columns' rounding

@@ -33,7 +33,7 @@ def test_the_rods_friction_is_recovered_at_the_rate_statistics_predicts():
     """20 seeded repeats: a key lies within 2σ with probability 0.954, so 5 or more misses out
     of 20 has probability < 0.3 %; within 1σ with 0.683, so 20 of 20 (σ grossly overstated)
     has probability 5e-4 and 8 or fewer (understated) about 1 %."""
-    report = _bench().main(["--quick", "--skip-map"])["fit"]
+    report = _bench().main(["--quick", "--skip-map", "--skip-posterior"])["fit"]
     for path in ("contacts.A.law.mu_s", "contacts.A.law.mu_d"):
         assert report[path]["within_2_sigma"] >= 16, report
         assert 9 <= report[path]["within_1_sigma"] <= 19, report

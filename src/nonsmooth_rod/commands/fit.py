@@ -28,6 +28,12 @@ def register(subparsers) -> None:
                    help="a scene key to estimate, with optional bounds; repeatable")
     p.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
                    help="override a value of the scene file (also the fit's start); repeatable")
+    p.add_argument("--posterior", action="store_true",
+                   help="also sample the keys' posterior by MCMC (emcee: the 'mcmc' extra); see docs/fitting.md")
+    p.add_argument("--walkers", type=int, default=16, metavar="N",
+                   help="MCMC walkers (default 16, even, ≥ 2 per key)")
+    p.add_argument("--posterior-steps", type=int, default=400, metavar="N",
+                   help="MCMC steps per walker (default 400; the first quarter is burn-in)")
     add_output_options(p, default_out="fit", figure="fit.png", force=False)
     p.set_defaults(handler=cmd_fit)
 
@@ -37,7 +43,8 @@ def cmd_fit(args) -> int:
     from ..studies.fitting import fit
     from .run import writable_folder
 
-    result = fit(args.scene, args.measured, args.free, sets=args.set)
+    result = fit(args.scene, args.measured, args.free, sets=args.set, posterior=args.posterior, walkers=args.walkers,
+                 posterior_steps=args.posterior_steps)
     out_dir = writable_folder(args.out)
     summary = result.as_dict()
     write_json(out_dir / "fit.json", summary)
@@ -70,4 +77,19 @@ def _report(result, out_dir) -> None:
     for q, m, f, r in list(zip(result.labels, result.measured, result.fitted, result.residuals))[:30]:
         res.add_row(escape(q), f"{m:.6g}", f"{f:.6g}", f"{r:+.2f}")
     console.print(res)
+    if result.posterior is not None:
+        _report_posterior(console, result.posterior)
     console.print(escape(f"{result.message}; {result.evaluations} simulations; files in {out_dir}/"))
+
+
+def _report_posterior(console, post) -> None:
+    from rich.table import Table
+
+    table = Table(title=f"posterior (MCMC: {post.walkers} walkers × {post.steps} steps, {post.burn} burn-in, "
+                        f"acceptance {post.acceptance:.2f})")
+    for col in ("key", "mean", "sd", "16 %", "median", "84 %", "autocorrelation [steps]"):
+        table.add_column(col)
+    for k in post.as_dict()["free"]:
+        table.add_row(escape(k["path"]), *(f"{k[c]:.6g}" for c in ("mean", "sd", "q16", "median", "q84")),
+                      f"{k['autocorrelation_steps']:.3g}")
+    console.print(table)

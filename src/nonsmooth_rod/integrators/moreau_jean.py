@@ -482,17 +482,23 @@ class MoreauJean:
         t_stop = None
         if run_status == loop.RUN_STOPPED:
             t_stop = max(i.t for i in impacts if i.contact == self.options.stop_at_impact)
-        phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end,
-                                              self.options.min_phase, t_stop)
-        events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
+        min_phase = self.options.min_phase
+
+        def locate(result):  # on first use of result.phases or result.events
+            phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop)
+            result.phases = phases
+            result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
         n_done = k_end - grid.first
         stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
                      solver_iterations=int(counters[loop.K_ITERATIONS]),
                      inconsistent_steps=int(counters[loop.K_INCONSISTENT]),
                      solver_fallbacks=int(counters[loop.K_FALLBACKS]),
                      steps_at_rest=int(counters[loop.K_REPEATED]))
-        result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, events,
-                                  impacts, phases, steps=n_done, cpu_time_s=cpu, stats=stats)
+        result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
+                                  impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
+        result.defer(locate)
+        if status == "failed":  # located now: a failed run's contacts may not bear evaluating later
+            result._settle()
         result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (

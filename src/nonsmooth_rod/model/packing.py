@@ -102,8 +102,9 @@ def pack_disk_pairs(table, index):
     vertex, radius 0; an edge or segment, around its middle — `_feature_circles`) and, sorted by
     circle pair, which contact joins them. Contacts on lines are not in them."""
     disk_id, disks, bodies, keys, owners = {}, [], [], [], []
-    for i in range(index.shape[0]):
-        circles = _feature_circles(index[i, CI_KIND], table[i], index[i, CI_BODY_A], index[i, CI_BODY_B])
+    rows, ints = table.tolist(), index.tolist()  # Python floats and ints: cheapest to read one by one
+    for i, (kind, body_a, body_b) in enumerate(ints):
+        circles = _feature_circles(kind, rows[i], body_a, body_b)
         if circles is None:
             continue
         ends = []
@@ -116,6 +117,9 @@ def pack_disk_pairs(table, index):
             ends.append(disk_id[disk])
         keys.append(ends)
         owners.append(i)
+    if not keys:  # contacts on lines only (most small scenes): no broad phase
+        empty = np.zeros(0, dtype=np.int64)
+        return np.zeros((0, 3)), empty, empty.copy(), empty.copy()
     n = len(disks)
     flat = np.array([min(a, b) * n + max(a, b) for a, b in keys], dtype=np.int64)
     order = np.argsort(flat, kind="stable")
@@ -142,7 +146,7 @@ def pack_drives(scene, table, index, minv):
     driven = np.array([(d.body, motion_index(d.motion)) for d in scene.driven], dtype=np.int64).reshape(-1, 2)
     for body in driven[:, 0]:
         minv[3 * body: 3 * body + 3] = 0.0
-    for i, c in enumerate(scene.contacts):
+    for i, c in enumerate(scene.contacts if driven.size else ()):  # M⁻¹ = 0 only where driven
         if all(minv[3 * b] == 0.0 for b in index[i, CI_BODY_A:CI_BODY_B + 1] if b >= 0):
             raise InputError(f"contact {c.name}: every body it touches is driven, so nothing it pushes can move")
     return (motions, *pack_motions(motions), driven)

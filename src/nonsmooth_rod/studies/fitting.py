@@ -25,7 +25,8 @@ from ..validation import InputError
 from .maps import scene_data
 from .measurements import Measurements, read_measurements
 from .outcome import contact_events
-from .paths import check_path, current_value, with_values
+from .patching import PointScenes
+from .paths import check_path, current_value
 
 DEFAULT_BOUNDS = {"mu_s": (0.0, 2.0), "mu_d": (0.0, 2.0), "restitution": (0.0, 1.0)}
 SENSITIVITY_FLOOR = 1e-6  # residual change (in sigmas) per unit of a key's scale below which it is unseen
@@ -77,11 +78,14 @@ class Model:
     free: list
     measured: Measurements
     calls: int = 0
+    scenes: PointScenes | None = None  # the scene parsed once, the free keys patched in (patching.py)
 
     def run(self, values):
         self.calls += 1
-        sf = parse_scene(with_values(self.data, dict(zip([f.path for f in self.free], values))), self.source)
-        return simulate_scene(sf)
+        paths = [f.path for f in self.free]
+        if self.scenes is None:
+            self.scenes = PointScenes(self.data, self.source, paths)
+        return simulate_scene(self.scenes.scene_file(dict(zip(paths, map(float, values)))))
 
     def predict(self, values) -> np.ndarray:
         """The model's value of every measured quantity, in the order of `labels`."""
@@ -264,6 +268,7 @@ class FitResult:
     evaluations: int
     measurements: Measurements = field(repr=False, default=None)
     start: np.ndarray = field(default=None)
+    posterior: object = field(repr=False, default=None)  # posterior.Posterior when asked for
 
     @property
     def residuals(self) -> np.ndarray:
@@ -287,7 +292,8 @@ class FitResult:
         return {"schema": "nonsmooth-rod/fit/1", "method": self.method, "success": self.success,
                 "message": self.message, "chi2": self.chi2, "dof": self.dof, "evaluations": self.evaluations,
                 "free": keys, "correlation": self.correlation.tolist(), "residuals": res,
-                "measured_files": self.measurements.files if self.measurements else []}
+                "measured_files": self.measurements.files if self.measurements else [],
+                **({"posterior": self.posterior.as_dict()} if self.posterior is not None else {})}
 
 
 def _reference_data(data: dict, source: str) -> tuple[dict, str]:
@@ -316,16 +322,22 @@ def _check_count(model: Model) -> None:
         raise InputError("--free: a path is given twice")
 
 
-def fit(scene, measured, free, *, sets=(), method: str | None = None, max_evaluations: int = 200) -> FitResult:
+def fit(scene, measured, free, *, sets=(), method: str | None = None, max_evaluations: int = 200,
+        posterior: bool = False, walkers: int = 16, posterior_steps: int = 400, seed: int = 0) -> FitResult:
     """Estimate the `free` keys of the scene file `scene` (a path or its content as a dict;
     `sets`: --set overrides) from `measured` (file paths, or a Measurements). `free`: texts
     'PATH' or 'PATH=LO:HI'. `method`: force the simulation method (default: the event-driven
-    reference where it handles the scene, else the file's). See the module doc."""
+    reference where it handles the scene, else the file's). `posterior`: also sample the keys'
+    posterior by MCMC (posterior.py: `walkers` × `posterior_steps` runs, seeded). See the module doc."""
     from scipy.optimize import least_squares
 
     data, source = scene_data(scene, sets)
     if not free:
         raise InputError("--free: name at least one scene key to estimate")
+    if posterior:
+        from .posterior import check_chain
+
+        check_chain(walkers, posterior_steps, len(free))
     if method is None:
         data, method = _reference_data(data, source)
     else:
@@ -357,6 +369,13 @@ def fit(scene, measured, free, *, sets=(), method: str | None = None, max_evalua
     J = jacobian(model, p, sig, fitted)
     sd, corr, verdicts = identifiability(J, frees)
     chi2 = float(np.sum(((fitted - obs) / sig) ** 2))
+    evaluations = model.calls
+    chain = None
+    if posterior:
+        from .posterior import sample_posterior
+
+        chain = sample_posterior(model, coords, p, sd, np.array([f.lo for f in frees]), np.array([f.hi for f in frees]),
+                                 walkers=walkers, steps=posterior_steps, seed=seed)
     return FitResult([f.path for f in frees], p, sd, corr, verdicts, [(f.lo, f.hi) for f in frees], model.labels,
-                     obs, sig, fitted, method, chi2, bool(sol.success), str(sol.message), model.calls, m,
-                     coords.physical(z0))
+                     obs, sig, fitted, method, chi2, bool(sol.success), str(sol.message), evaluations, m,
+                     coords.physical(z0), chain)

@@ -6,7 +6,9 @@ moving together) with its values. Each point is the file with those
 values, run with the file's own method and options; its row holds the axes, then the outcome
 (outcome.py): the regime (every contact's phase sequence), status, whether the scene held, each
 contact's first slip / stick / lift-off / impact time, the final state. A point the scene
-refuses (μd > μs, ...) is recorded with the regime "refused".
+refuses (μd > μs, ...) is recorded with the regime "refused". Each worker parses the scene once
+and patches every point's values into it where the paths allow (patching.py: laws, initial state,
+run settings), the same scene the full parse of the point gives.
 
 The points run on the rod's sweep machinery (runner.py, executors.py): chunks on a local pool,
 a Dask LocalCluster or a scheduler; rows streamed to DIR/map.csv (resumed when rerun), the
@@ -29,7 +31,8 @@ from ..scenefile import parse_scene, read_data, simulate_scene
 from ..validation import InputError
 from . import runner
 from .outcome import outcome_columns, outcome_row, refused_row
-from .paths import apply_sets, check_path, with_values
+from .patching import PointScenes, point_scenes
+from .paths import apply_sets, check_path
 
 SCHEMA = "nonsmooth-rod/scene-sweep/1"
 CSV_NAME, PARQUET_NAME, SETTINGS_NAME, BOUNDARIES_NAME, MAP_NAME = (
@@ -76,12 +79,13 @@ def scene_data(scene, sets=()) -> tuple[dict, str]:
 
 
 # --------------------------------------------------------------------------- one point
-def run_point(data: dict, source: str, paths, point, names) -> dict:
-    """The row of one point: its axis values, then its outcome."""
+def run_point(data: dict, source: str, paths, point, names, scenes: PointScenes | None = None) -> dict:
+    """The row of one point: its axis values, then its outcome. `scenes`: the map's scene at
+    each point (patching.PointScenes; default: this worker's, built once)."""
     contacts, n_dof = names
     row = dict(zip(paths, map(float, point)))
     try:
-        sf = parse_scene(with_values(data, row), source)
+        sf = (scenes or point_scenes(data, source, paths)).scene_file(row)
     except InputError as err:
         return row | refused_row(contacts, n_dof, "refused", str(err))
     try:
@@ -92,8 +96,9 @@ def run_point(data: dict, source: str, paths, point, names) -> dict:
 
 
 def _run_chunk(data, source, paths, names, points) -> list[dict]:
+    scenes = point_scenes(data, source, paths)  # the base scene parsed once per worker
     with _jit.one_blas_thread():  # once per chunk, not once per short run
-        return [run_point(data, source, paths, pt, names) for pt in points]
+        return [run_point(data, source, paths, pt, names, scenes) for pt in points]
 
 
 def _base_run(data: dict, source: str):
