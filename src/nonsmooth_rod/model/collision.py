@@ -85,6 +85,11 @@ class Polygon:
         """The normal cone of vertex k: the outward normals of its previous and next edges."""
         return self.normal((k - 1) % len(self.vertices)), self.normal(k)
 
+    def neighbours(self, k: int):
+        """The outward normals of the edges before and after edge k."""
+        n = len(self.vertices)
+        return self.normal((k - 1) % n), self.normal((k + 1) % n)
+
     @property
     def width(self) -> float:
         """The smallest extent across an edge (its thinnest direction)."""
@@ -188,7 +193,8 @@ def polygon_pair_contacts(poly_a, body_a, name_a, poly_b, body_b, name_b, law, t
         for i, vertex in enumerate(pv.vertices):
             for k in range(len(pe.vertices)):
                 found.append(VertexOnEdge(bv, vertex, be, *pe.edge(k), cone=pv.cone(i), tie_wins=wins,
-                                          depth_limit=depth, law=law, name=f"{nv}.v{i}/{ne}.e{k}"))
+                                          depth_limit=depth, law=law, name=f"{nv}.v{i}/{ne}.e{k}",
+                                          neighbours=pe.neighbours(k)))
     return found
 
 
@@ -220,7 +226,8 @@ def _polygon_segment(poly, body, name, seg, seg_name, law):
             edge = poly.edge(k)
             found.append((("ve", -1, _r(point), body, _r(edge[0]), _r(edge[1]), 0.0),
                           VertexOnEdge(-1, point, body, *edge, cone=cone, tie_wins=False, depth_limit=depth,
-                                       law=law, name=f"{seg_name}.{end_name}/{name}.e{k}")))
+                                       law=law, name=f"{seg_name}.{end_name}/{name}.e{k}",
+                                       neighbours=poly.neighbours(k))))
     return found
 
 
@@ -229,7 +236,8 @@ def _disk_polygon(disk, body, name, poly, pbody, pname, law):
     vertex (a disk of radius 0): the nearest feature touches."""
     depth = DEPTH_FRACTION * min(poly.width, disk.radius)
     found = [VertexOnEdge(body, disk.offset, pbody, *poly.edge(k), radius=disk.radius, depth_limit=depth, law=law,
-                          name=f"{name}/{pname}.e{k}") for k in range(len(poly.vertices))]
+                          name=f"{name}/{pname}.e{k}", neighbours=poly.neighbours(k))
+             for k in range(len(poly.vertices))]
     if pbody >= 0:
         found += [DiskOnDisk(body, pbody, disk.radius, 0.0, disk.offset, vertex, law, f"{name}/{pname}.v{i}")
                   for i, vertex in enumerate(poly.vertices)]
