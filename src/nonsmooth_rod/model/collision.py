@@ -354,3 +354,37 @@ def _declared_key(c):
     if isinstance(c, VertexOnEdge):
         return ("ve", c.vertex_body, _r(c.vertex), c.edge_body, _r(c.edge_start), _r(c.edge_end), _r(c.radius))
     return None
+
+
+def deepest_overlap(bodies, shapes: dict, q, lines=()) -> float:
+    """The deepest overlap (m) of any two bodies' polygons, or of a polygon's vertex behind one of
+    `lines`, at the configurations q (one row per sample): separating axes over every pair of
+    polygons, whatever contacts a scene lists or filters out — a check of a run's physics (no box
+    through another or the floor) independent of the contact kernels. 0 when nothing overlaps."""
+    polygons = [(k, shapes[b.name]) for k, b in enumerate(bodies) if isinstance(shapes.get(b.name), Polygon)]
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    deepest = 0.0
+    for row in q:
+        world = [_world(p.vertices, row[3 * k: 3 * k + 3]) for k, p in polygons]
+        axes = [_edge_normals(w) for w in world]
+        for line in lines:
+            n, point = np.array(line.normal), np.array(line.point)
+            deepest = max(deepest, max(float(np.max((point - w) @ n)) for w in world))
+        for a in range(len(world)):
+            for b in range(a + 1, len(world)):
+                both = np.vstack([axes[a], axes[b]])
+                pa, pb = world[a] @ both.T, world[b] @ both.T
+                overlap = np.minimum(pa.max(axis=0), pb.max(axis=0)) - np.maximum(pa.min(axis=0), pb.min(axis=0))
+                deepest = max(deepest, float(overlap.min()))
+    return deepest
+
+
+def _world(vertices, pose) -> np.ndarray:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    v = np.array(vertices)
+    return np.column_stack([pose[0] + c * v[:, 0] - s * v[:, 1], pose[1] + s * v[:, 0] + c * v[:, 1]])
+
+
+def _edge_normals(world: np.ndarray) -> np.ndarray:
+    edges = np.roll(world, -1, axis=0) - world
+    return np.column_stack([edges[:, 1], -edges[:, 0]]) / np.hypot(edges[:, 0], edges[:, 1])[:, None]
