@@ -38,7 +38,7 @@ class BoxHeap:
     tilt: float = 0.2
     mu_s: float = 0.5
     mu_d: float = 0.4
-    seed: int = 1
+    seed: int = 2
     g: float = G
 
     def __post_init__(self):
