@@ -149,3 +149,89 @@ def peers_step_us(scene, h, steps, repeats):
         if us is not None:
             out.append((name, us))
     return out
+
+
+# Boxes (bench_shapes.py): a scene is a dict with boxes [(x, y, θ, vx, vy, ω)], width, height,
+# mass, mu (box–box), mu_line (box–line), lines [(point, angle)] (our Line: normal = the tangent
+# turned by +90°) and depth (MuJoCo's out-of-plane half-thickness of a box).
+BOX_PEER_SETTINGS = {
+    "mujoco": "planar (slide x, slide z, hinge y); box geoms (half-depth 0.05 m out of plane), plane floor and "
+              "walls; Newton, 100 iterations, tol 1e-8, pyramidal cone, condim 3, default solref/solimp; one "
+              "friction per pair (MuJoCo takes the larger of the two geoms': set per geom)",
+    "pymunk10": "Chipmunk2D boxes (Poly.create_box, radius 0) on static segments, space.iterations = 10 (default), "
+                "collision_slop 1e-4 m (default 0.1: a tenth of a metre of overlap allowed), friction sqrt(mu) "
+                "per shape",
+    "pymunk100": "as pymunk10 with space.iterations = 100",
+}
+
+
+def _line_ends(point, angle, half=50.0):
+    c, s = math.cos(angle), math.sin(angle)
+    return (point[0] - half * c, point[1] - half * s), (point[0] + half * c, point[1] + half * s)
+
+
+def mujoco_boxes_step_us(scene, h, steps, repeats):
+    """mj_step per step on planar boxes, or None when MuJoCo is not installed."""
+    try:
+        import mujoco
+    except ImportError:
+        return None
+    w, ht, d, m = scene["width"] / 2, scene["height"] / 2, scene["depth"], scene["mass"]
+    bodies = "".join(
+        f'<body pos="{x} 0 {y}" quat="{math.cos(-th / 2)} 0 {math.sin(-th / 2)} 0"><joint type="slide" axis="1 0 0"/>'
+        f'<joint type="slide" axis="0 0 1"/><joint type="hinge" axis="0 1 0"/>'
+        f'<geom type="box" size="{w} {d} {ht}" mass="{m}" friction="{scene["mu"]} 0.005 0.0001"/></body>'
+        for x, y, th, *_ in scene["boxes"])
+    planes = "".join(
+        f'<geom type="plane" size="50 50 0.1" pos="{p[0]} 0 {p[1]}" zaxis="{-math.sin(a)} 0 {math.cos(a)}" '
+        f'friction="{scene["mu_line"]} 0.005 0.0001"/>' for p, a in scene["lines"])
+    xml = (f'<mujoco><option timestep="{h}"/><default><geom condim="3"/></default>'
+           f'<worldbody>{planes}{bodies}</worldbody></mujoco>')
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+
+    def reset():
+        mujoco.mj_resetData(model, data)
+        for b, (*_, vx, vy, om) in enumerate(scene["boxes"]):
+            data.qvel[3 * b: 3 * b + 3] = (vx, vy, -om)  # our ω about +z is −ω about MuJoCo's +y
+
+    return _median_step_us(lambda: mujoco.mj_step(model, data), reset, steps, repeats)
+
+
+def pymunk_boxes_step_us(scene, h, steps, repeats, iterations):
+    """space.step per step on boxes with `iterations`, or None when pymunk is not installed."""
+    try:
+        import pymunk
+    except ImportError:
+        return None
+    w, ht, m = scene["width"], scene["height"], scene["mass"]
+    holder = {}
+
+    def reset():
+        space = pymunk.Space()
+        space.iterations, space.collision_slop, space.gravity = iterations, 1e-4, (0.0, -9.81)
+        for point, angle in scene["lines"]:
+            segment = pymunk.Segment(space.static_body, *_line_ends(point, angle), 0.0)
+            segment.friction, segment.elasticity = scene["mu_line"] / math.sqrt(scene["mu"]), 0.0
+            space.add(segment)
+        for x, y, th, vx, vy, om in scene["boxes"]:
+            body = pymunk.Body(m, pymunk.moment_for_box(m, (w, ht)))
+            body.position, body.angle, body.velocity, body.angular_velocity = (x, y), th, (vx, vy), om
+            box = pymunk.Poly.create_box(body, (w, ht), 0.0)
+            box.friction, box.elasticity = math.sqrt(scene["mu"]), 0.0
+            space.add(body, box)
+        holder["space"] = space
+
+    return _median_step_us(lambda: holder["space"].step(h), reset, steps, repeats)
+
+
+def box_peers_step_us(scene, h, steps, repeats):
+    """[(peer, µs per step)] of every installed peer on a boxes `scene`."""
+    out = []
+    for name, cost in (("mujoco", lambda: mujoco_boxes_step_us(scene, h, steps, repeats)),
+                       ("pymunk10", lambda: pymunk_boxes_step_us(scene, h, steps, repeats, 10)),
+                       ("pymunk100", lambda: pymunk_boxes_step_us(scene, h, steps, repeats, 100))):
+        us = cost()
+        if us is not None:
+            out.append((name, us))
+    return out

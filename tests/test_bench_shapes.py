@@ -18,3 +18,16 @@ def test_bench_shapes_quick(capsys):
     creeps = [float(x) for x in re.findall(r"creep ([0-9.e+-]+) m", out)]
     assert len(creeps) == 2 and max(creeps) < 1e-10
     assert "finding the contacts costs" in out
+
+
+def test_bench_shapes_peers_quick(capsys):
+    """--peers --quick: the tower, the dominoes and a heap of 20 boxes, ours (and the peers when
+    installed), each of ours with its deepest overlap — under a step of travel (1 ms) at the speed
+    of a fall from the heap's top layer (1.5 m)."""
+    spec = importlib.util.spec_from_file_location("bench_shapes", BENCH)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--peers", "--quick"]) == 0
+    out = capsys.readouterr().out
+    overlaps = [float(x) for x in re.findall(r"ok, deepest overlap ([0-9.e+-]+) m", out)]
+    assert len(overlaps) == 3 and max(overlaps) < 1e-3 * (2 * 9.81 * 1.5) ** 0.5, out

@@ -43,6 +43,20 @@ def test_laws_by_pair_and_collide_false():
     assert laws["a/b"].impact.restitution == 0.5 and laws["a/b"].friction.mu_s == 0.0
 
 
+def test_collides_with_lists_what_a_body_meets():
+    disks = [{"name": n, "shape": "disk", "radius": 0.1, "mass": 1.0} for n in "abc"]
+    disks[0]["collides_with"] = ["b", "floor"]
+    sf = _scene(disks, {"a": [0.0, 0.1, 0.0], "b": [0.2, 0.1, 0.0], "c": [0.4, 0.1, 0.0]})
+    assert sorted(sf.contact_names) == ["a/b", "a/floor", "b/c", "b/floor", "c/floor"]  # no a/c
+    disks[0]["collides_with"] = ["b"]
+    sf = _scene(disks, {"a": [0.0, 0.1, 0.0], "b": [0.2, 0.1, 0.0], "c": [0.4, 0.1, 0.0]})
+    assert "a/floor" not in sf.contact_names
+    for bad, message in ((["d"], "'d' names no body"), ("b", "must be a list")):
+        disks[0]["collides_with"] = bad
+        with pytest.raises(InputError, match=f"^s.toml: bodies.a.collides_with: .*{message}"):
+            _scene(disks, {"a": [0.0, 0.1, 0.0], "b": [0.2, 0.1, 0.0], "c": [0.4, 0.1, 0.0]})
+
+
 def test_declared_contacts_keep_their_pair():
     sf = _scene([{"name": "box", "shape": "rectangle", "width": 0.4, "height": 0.2, "mass": 1.0}],
                 {"box": [0.0, 0.1, 0.0]},

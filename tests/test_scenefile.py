@@ -240,6 +240,22 @@ def _leaves(node, path=()):
         yield path
 
 
+# Shipped scenes of many repeated bodies, cut to their first two for the hostile values (every
+# key of a body is the same key in each; parsing the whole row thousands of times takes minutes).
+CUT_TO_TWO = {"dominoes"}
+
+
+def _first_two_bodies(data):
+    keep = [b["name"] for b in data["bodies"][:2]]
+    for body in data["bodies"][:2]:
+        if "collides_with" in body:
+            body["collides_with"] = [x for x in body["collides_with"] if x in keep or x not in
+                                     {b["name"] for b in data["bodies"]}]
+    data["bodies"] = data["bodies"][:2]
+    data["initial"] = {k: v for k, v in data["initial"].items() if k in keep}
+    return data
+
+
 @pytest.mark.parametrize("name", sorted(p.stem for p in SCENES.glob("*.toml")))
 def test_hostile_values_anywhere_are_refused_in_one_line_or_give_a_finite_scene(name):
     """Every key of every shipped scene set to each hostile value (JSON null included): the
@@ -250,6 +266,8 @@ def test_hostile_values_anywhere_are_refused_in_one_line_or_give_a_finite_scene(
     from nonsmooth_rod.scenefile import read_data
 
     data, _ = read_data(SCENES / f"{name}.toml")
+    if name in CUT_TO_TWO:
+        data = _first_two_bodies(data)
     for path in list(_leaves(data)):
         for value in HOSTILE:
             changed = copy.deepcopy(data)

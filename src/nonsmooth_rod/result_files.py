@@ -119,7 +119,8 @@ def _contact_data(contact, bodies, lines, segments) -> dict:
                 "edge_body": bodies[contact.edge_body] if contact.edge_body >= 0 else None,
                 **{k: _plain(getattr(contact, k)) for k in ("vertex", "edge_start", "edge_end", "cone", "radius",
                                                             "tie_wins")},
-                "depth_limit": contact.depth_limit if math.isfinite(contact.depth_limit) else None}
+                "depth_limit": contact.depth_limit if math.isfinite(contact.depth_limit) else None,
+                "neighbours": _plain(contact.neighbours)}
     line = contact.line
     name = next((n for n, known in lines.items() if known == line), f"line{len(lines)}")
     lines[name] = line

@@ -4,9 +4,10 @@ reads them (it passes its `_Where`, which builds the one-line errors).
 
 A body with shape disk, ball, rectangle, polygon or rod-with-balls (two disks) collides with
 every other such body, line and segment unless `collide = false`; bodies of one `group` never
-collide with each other. A pair of shapes between which the file declares any contact by hand
-is not searched: the declared contacts say how those two touch (so a scene written before
-shapes collided keeps its contacts and its results).
+collide with each other; a body with `collides_with = [names]` collides with those only. A pair
+of shapes between which the file declares any contact by hand is not searched: the declared
+contacts say how those two touch (so a scene written before shapes collided keeps its contacts
+and its results).
 """
 from __future__ import annotations
 
@@ -131,6 +132,23 @@ def _declared_pairs(declared, body_names, obstacles) -> list:
     return pairs
 
 
+def _outside_lists(w, tables, names) -> list:
+    """(body, name) of every pair a body's `collides_with` list leaves out."""
+    never = []
+    for body, t in tables.items():
+        listed = t.get("collides_with")
+        if listed is None:
+            continue
+        key = f"bodies.{body}.collides_with"
+        if not isinstance(listed, list) or not all(isinstance(x, str) for x in listed):
+            raise w.error(key, f"must be a list of names of bodies, lines or segments, got {listed!r}")
+        for name in listed:
+            if name not in names:
+                raise w.error(key, f"{name!r} names no body, line or segment")
+        never += [(body, name) for name in names if name != body and name not in listed]
+    return never
+
+
 def found_contacts(w, data, bodies, shapes: dict, lines: dict, segments: dict, declared) -> list:
     """The contacts found between the file's colliding shapes (module docstring)."""
     tables = {t.get("name"): t for t in data.get("bodies", []) if isinstance(t, dict)}
@@ -157,6 +175,7 @@ def found_contacts(w, data, bodies, shapes: dict, lines: dict, segments: dict, d
     if not colliding:
         return []
     never = _declared_pairs(declared, [b.name for b in bodies], obstacles)
+    never += _outside_lists(w, tables, names)
     try:
         return find_contacts(bodies, colliding, obstacles, laws, never=never, groups=groups)
     except InputError as err:

@@ -46,8 +46,8 @@ MAX_DEPTH = 16  # tables and lists nest at most this deep (a scene needs 4)
 TOP_KEYS = ("schema", "title", "description", "gravity", "bodies", "lines", "segments", "contacts", "forces",
             "joints", "initial", "simulation", "laws")
 BODY_KEYS = ("name", "mass", "inertia", "shape", "density", "thickness", "radius", "width", "height",
-             "length", "ball_radius", "rod_diameter", "vertices", "collide", "group")
-COLLISION_KEYS = ("collide", "group")  # scene_collisions.py: not dimensions of a shape
+             "length", "ball_radius", "rod_diameter", "vertices", "collide", "group", "collides_with")
+COLLISION_KEYS = ("collide", "group", "collides_with")  # scene_collisions.py: not dimensions of a shape
 LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length", "motion")
 SEGMENT_KEYS = ("name", "a", "b", "motion")
 # A prescribed motion (model/motion.py) of a line, segment or body: a displacement from its placement.

@@ -37,7 +37,7 @@ def modes(summary, contact):
 def test_every_shipped_scene_has_a_test():
     tested = {"bouncing_ball", "block_on_incline", "pushed_block", "disk_on_incline", "belt_oscillator",
               "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod", "ball_off_table",
-              "box_off_table", "pendulum_wall", "shaken_block"}
+              "box_off_table", "pendulum_wall", "shaken_block", "dominoes"}
     assert {p.stem for p in SCENES.glob("*.toml")} == tested
 
 
@@ -53,6 +53,23 @@ def test_box_off_table_pivots_where_the_moment_of_friction_is_no_longer_balanced
     t_pivot = (v0 - math.sqrt(v0 * v0 - 2 * a * (-mu_d * height / 2 - x0))) / a
     assert s["phases"]["block.v0/table.side+"][0]["t_end"] == pytest.approx(t_pivot, abs=3 * H)
     assert c["block.y"][-1] < 0.5  # off the table (its top at 0.8 m)
+
+
+def test_dominoes_topple_at_1_1_times_the_tipping_impulse_and_not_at_0_9(tmp_path):
+    """The file's push is 1.1 J* (its comment's closed form, toys.Dominoes): the whole row falls;
+    at 0.9 J* (d0's v scaled by 9/11) d0 rocks back and no other domino moves."""
+    toy = toys.Dominoes(push_ratio=1.1)
+    _, v0 = toy.initial_state()
+    from nonsmooth_rod.scenefile import load_scene
+
+    assert load_scene(SCENES / "dominoes.toml").v0[:3] == pytest.approx(v0[:3], rel=1e-8)
+    _, c = run(tmp_path, "dominoes")
+    assert all(c[f"d{k}.theta"][-1] < -math.atan2(0.005, 0.025) for k in range(20))
+    scaled = [float(x) * 9 / 11 for x in v0[:3]]
+    _, c = run(tmp_path, "dominoes", "--set", f"initial.d0.v=[{scaled[0]!r}, {scaled[1]!r}, {scaled[2]!r}]",
+               "--set", "simulation.t_end=1.0")
+    assert max(c["d0.theta"]) > 0.0 and min(c["d0.theta"]) > -math.atan2(0.005, 0.025)  # rocks, never tips
+    assert np.abs(c["d1.theta"]).max() < 1e-12
 
 
 def test_pendulum_striking_a_wall_rebounds_to_the_closed_form_angle(tmp_path):

@@ -216,9 +216,6 @@ def test_the_event_driven_reference_runs_polygons_on_lines_and_refuses_segments_
         nr.simulate(nr.Scene([box], on_table), np.array([0.0, 0.1, 0.0]), np.zeros(3), 0.1, "event-driven")
 
 
-@pytest.mark.xfail(strict=True, reason="known defect: a segment's end resting on a box's side also counts "
-                   "against the box's top (a wrong pair within DEPTH_FRACTION: -0.13 m at t = 0.72 s); the "
-                   "fix is the edge's neighbour normals in the row (the least penetrated edge wins, local SAT)")
 def test_boxes_and_a_ball_dropped_in_a_heap_do_not_pass_through_each_other():
     """Three tilted boxes and a ball dropped onto a floor, a ramp and each other for 3 s: faces
     rock on faces and corners slide off edges, and no shape ever sinks into another by more than

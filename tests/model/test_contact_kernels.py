@@ -351,3 +351,29 @@ def test_bad_vertex_on_edge_input_is_one_line():
         VertexOnEdge(0, (0.0, 0.0), 1, (0.0, 0.0), (1.0, 1.0))
     with pytest.raises(InputError, match="vertex_body and edge_body must differ"):
         VertexOnEdge(1, (0.0, 0.0), 1, (0.0, 0.0), (1.0, 1.0), radius=0.1)
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.7])
+def test_a_point_that_crossed_two_edges_counts_against_the_least_penetrated(theta):
+    """A ramp's end 1 cm inside a box's left side and 5 cm under its top (the box turned by θ
+    with it): the side touches, 1 cm deep; the top (5 cm, within the depth limit) does not. A
+    disk centred there likewise; the box's own corner, whose cone admits no side, keeps its top."""
+    from nonsmooth_rod.model.collision import Polygon, find_contacts
+    from nonsmooth_rod.model.body import RigidBody
+
+    box = RigidBody(1.0, 0.02, name="box")
+    end = _rotate(theta, (-0.19, 0.1))
+    ramp = Segment(tuple(_rotate(theta, (-1.0, 0.4))), tuple(end), name="ramp")
+    found = {c.name: c for c in find_contacts([box], {"box": Polygon.rectangle(0.4, 0.3)}, {"ramp": ramp})}
+    q = np.array([0.0, 0.0, theta])
+    assert found["ramp.b/box.e3"].kinematics(q, np.zeros(3), 3).gap == pytest.approx(-0.01, abs=1e-12)
+    assert found["ramp.b/box.e2"].kinematics(q, np.zeros(3), 3).gap == math.inf
+    square = Polygon(SQUARE)
+    disk = VertexOnEdge(1, (0.0, 0.0), 0, *square.edge(2), radius=0.05, neighbours=square.neighbours(2))
+    at = np.array([0.0, 0.0, 0.0, -0.49, 0.45, 0.0])  # the disk's centre 1 cm inside the left side, 5 cm under the top
+    assert disk.kinematics(at, np.zeros(6), 6).gap == math.inf
+    corner = VertexOnEdge(1, SQUARE[0], 0, *square.edge(2), cone=square.cone(0), neighbours=square.neighbours(2))
+    at = np.array([0.0, 0.0, 0.0, 0.5, 0.98, 0.0])  # its corner 2 cm into the top, 50 cm inside the left side
+    assert corner.kinematics(at, np.zeros(6), 6).gap == pytest.approx(-0.02, abs=1e-12)
+    at[3] = 0.01  # its corner 1 cm inside the left side, 2 cm into the top: the side cannot push it
+    assert corner.kinematics(at, np.zeros(6), 6).gap == pytest.approx(-0.02, abs=1e-12)

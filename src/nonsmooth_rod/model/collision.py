@@ -85,6 +85,11 @@ class Polygon:
         """The normal cone of vertex k: the outward normals of its previous and next edges."""
         return self.normal((k - 1) % len(self.vertices)), self.normal(k)
 
+    def neighbours(self, k: int):
+        """The outward normals of the edges before and after edge k."""
+        n = len(self.vertices)
+        return self.normal((k - 1) % n), self.normal((k + 1) % n)
+
     @property
     def width(self) -> float:
         """The smallest extent across an edge (its thinnest direction)."""
@@ -188,7 +193,8 @@ def polygon_pair_contacts(poly_a, body_a, name_a, poly_b, body_b, name_b, law, t
         for i, vertex in enumerate(pv.vertices):
             for k in range(len(pe.vertices)):
                 found.append(VertexOnEdge(bv, vertex, be, *pe.edge(k), cone=pv.cone(i), tie_wins=wins,
-                                          depth_limit=depth, law=law, name=f"{nv}.v{i}/{ne}.e{k}"))
+                                          depth_limit=depth, law=law, name=f"{nv}.v{i}/{ne}.e{k}",
+                                          neighbours=pe.neighbours(k)))
     return found
 
 
@@ -220,7 +226,8 @@ def _polygon_segment(poly, body, name, seg, seg_name, law):
             edge = poly.edge(k)
             found.append((("ve", -1, _r(point), body, _r(edge[0]), _r(edge[1]), 0.0),
                           VertexOnEdge(-1, point, body, *edge, cone=cone, tie_wins=False, depth_limit=depth,
-                                       law=law, name=f"{seg_name}.{end_name}/{name}.e{k}")))
+                                       law=law, name=f"{seg_name}.{end_name}/{name}.e{k}",
+                                       neighbours=poly.neighbours(k))))
     return found
 
 
@@ -229,7 +236,8 @@ def _disk_polygon(disk, body, name, poly, pbody, pname, law):
     vertex (a disk of radius 0): the nearest feature touches."""
     depth = DEPTH_FRACTION * min(poly.width, disk.radius)
     found = [VertexOnEdge(body, disk.offset, pbody, *poly.edge(k), radius=disk.radius, depth_limit=depth, law=law,
-                          name=f"{name}/{pname}.e{k}") for k in range(len(poly.vertices))]
+                          name=f"{name}/{pname}.e{k}", neighbours=poly.neighbours(k))
+             for k in range(len(poly.vertices))]
     if pbody >= 0:
         found += [DiskOnDisk(body, pbody, disk.radius, 0.0, disk.offset, vertex, law, f"{name}/{pname}.v{i}")
                   for i, vertex in enumerate(poly.vertices)]
@@ -346,3 +354,37 @@ def _declared_key(c):
     if isinstance(c, VertexOnEdge):
         return ("ve", c.vertex_body, _r(c.vertex), c.edge_body, _r(c.edge_start), _r(c.edge_end), _r(c.radius))
     return None
+
+
+def deepest_overlap(bodies, shapes: dict, q, lines=()) -> float:
+    """The deepest overlap (m) of any two bodies' polygons, or of a polygon's vertex behind one of
+    `lines`, at the configurations q (one row per sample): separating axes over every pair of
+    polygons, whatever contacts a scene lists or filters out — a check of a run's physics (no box
+    through another or the floor) independent of the contact kernels. 0 when nothing overlaps."""
+    polygons = [(k, shapes[b.name]) for k, b in enumerate(bodies) if isinstance(shapes.get(b.name), Polygon)]
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    deepest = 0.0
+    for row in q:
+        world = [_world(p.vertices, row[3 * k: 3 * k + 3]) for k, p in polygons]
+        axes = [_edge_normals(w) for w in world]
+        for line in lines:
+            n, point = np.array(line.normal), np.array(line.point)
+            deepest = max(deepest, max(float(np.max((point - w) @ n)) for w in world))
+        for a in range(len(world)):
+            for b in range(a + 1, len(world)):
+                both = np.vstack([axes[a], axes[b]])
+                pa, pb = world[a] @ both.T, world[b] @ both.T
+                overlap = np.minimum(pa.max(axis=0), pb.max(axis=0)) - np.maximum(pa.min(axis=0), pb.min(axis=0))
+                deepest = max(deepest, float(overlap.min()))
+    return deepest
+
+
+def _world(vertices, pose) -> np.ndarray:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    v = np.array(vertices)
+    return np.column_stack([pose[0] + c * v[:, 0] - s * v[:, 1], pose[1] + s * v[:, 0] + c * v[:, 1]])
+
+
+def _edge_normals(world: np.ndarray) -> np.ndarray:
+    edges = np.roll(world, -1, axis=0) - world
+    return np.column_stack([edges[:, 1], -edges[:, 0]]) / np.hypot(edges[:, 0], edges[:, 1])[:, None]

@@ -49,7 +49,12 @@ SEAM_TOL, FACE_TOL = 1e-9, 0.0175
 # velocity (world frame) at the step's end and at its start, which the step subtracts from the
 # contact's relative velocity at the end (the law) and at the start (activation, u_N before impact).
 C_MOTION, C_BASE_PX, C_BASE_PY, C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY = range(25, 32)
-N_CONTACT_COLUMNS = 32
+# A vertex on an edge of a polygon: the outward normals of the edge's previous and next edges
+# (the edge owner's frame; zero: no neighbour — a segment's side, a hand-declared edge). Of the
+# edges a point has crossed, only the least penetrated one is its pair (separating axes, locally):
+# a segment's end resting on a box's side is not also a deep contact on the box's top.
+C_PREV_NX, C_PREV_NY, C_NEXT_NX, C_NEXT_NY = range(32, 36)
+N_CONTACT_COLUMNS = 36
 
 
 @jitable
@@ -229,6 +234,36 @@ def _vertex_feature_valid(row, along, length, dx, dy, ca, sa):
 
 
 @jitable
+def _in_cone(row, dx, dy, ca, sa):
+    """Whether the direction d lies in the vertex's normal cone (within FACE_TOL)."""
+    n1x, n1y = ca * row[C_CONE_1X] - sa * row[C_CONE_1Y], sa * row[C_CONE_1X] + ca * row[C_CONE_1Y]
+    n2x, n2y = ca * row[C_CONE_2X] - sa * row[C_CONE_2Y], sa * row[C_CONE_2X] + ca * row[C_CONE_2Y]
+    return n1x * dy - n1y * dx >= -FACE_TOL and dx * n2y - dy * n2x >= -FACE_TOL
+
+
+@jitable
+def _least_penetrated(row, dx, dy, height, tx, ty, length, cb, sb, ca, sa, is_vertex):
+    """Whether the point at d = P − E (world axes; `height` its signed distance above the edge)
+    is no deeper behind this edge than behind either neighbouring edge it could touch instead
+    (a vertex: the neighbour's normal, turned around, in its cone; a disk: any). The previous
+    edge passes through the edge's start E, the next one through its end E + length τ."""
+    tol = SEAM_TOL * length
+    return not (_neighbour_wins(row, C_PREV_NX, C_PREV_NY, dx, dy, height + tol, cb, sb, ca, sa, is_vertex)
+                or _neighbour_wins(row, C_NEXT_NX, C_NEXT_NY, dx - length * tx, dy - length * ty, height + tol,
+                                   cb, sb, ca, sa, is_vertex))
+
+
+@jitable
+def _neighbour_wins(row, x_col, y_col, dx, dy, height, cb, sb, ca, sa, is_vertex):
+    """Whether the point at d from a point of a neighbouring edge is higher above it than `height`."""
+    mx, my = row[x_col], row[y_col]
+    if mx == 0.0 and my == 0.0:
+        return False
+    mx, my = cb * mx - sb * my, sb * mx + cb * my
+    return mx * dx + my * dy > height and (not is_vertex or _in_cone(row, -mx, -my, ca, sa))
+
+
+@jitable
 def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
     """A vertex (or a disk of radius C_RADIUS_A) of `point_body` (−1: fixed) on a straight edge
     of `edge_body` (−1: fixed), the edge's outward normal n = τ turned by −90° (a CCW outline).
@@ -258,6 +293,8 @@ def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
     valid = -tol <= along <= length + tol and gap >= -row[C_DEPTH_LIMIT]
     if valid and r == 0.0:
         valid = _vertex_feature_valid(row, along, length, -nx, -ny, ca, sa)
+    if valid and gap < 0.0:
+        valid = _least_penetrated(row, dx, dy, gap + r, tx, ty, length, cb, sb, ca, sa, r == 0.0)
     if not valid:
         return math.inf, 0.0, 0.0
     # w: velocity of P's material point relative to E's; at fixed v the levers turn, so

@@ -29,7 +29,8 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_
                               KIND_SEGMENT_END_ON_EDGE, N_CONTACT_COLUMNS, kinematics_kernel, C_CONE_1X,
                               C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_DEPTH_LIMIT, C_TIE_WINS, KIND_VERTEX_ON_EDGE,
                               KIND_FIXED_VERTEX_ON_EDGE, C_OBSTACLE_VX, C_OBSTACLE_VY,
-                              C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, obstacle_velocity)
+                              C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, obstacle_velocity, C_PREV_NX,
+                              C_PREV_NY, C_NEXT_NX, C_NEXT_NY)
 from .motion import require_motion
 from .laws import ContactLaw
 
@@ -401,7 +402,9 @@ class VertexOnEdge(_PackedRelation):
     outward normals of its previous and next edges, vertex owner's frame; None for a disk) and
     a penetration under `depth_limit`; otherwise its gap is infinite (open). At a corner exactly
     on a corner the pair keeps the contact only if `tie_wins` (model/collision.py gives the
-    tie to one of the two mirror pairs)."""
+    tie to one of the two mirror pairs). `neighbours`: the outward normals of the edge's previous
+    and next edges (edge owner's frame; None: the edge stands alone, a segment's side): a point
+    that has crossed a neighbour too counts against the least penetrated of them only."""
 
     vertex_body: int
     vertex: tuple[float, float]
@@ -414,6 +417,7 @@ class VertexOnEdge(_PackedRelation):
     depth_limit: float = math.inf
     law: ContactLaw = field(default_factory=ContactLaw)
     name: str = "vertex-edge"
+    neighbours: tuple | None = None
 
     def __post_init__(self):
         self.name = _contact_name(self.name)
@@ -432,6 +436,10 @@ class VertexOnEdge(_PackedRelation):
             if self.cone is None or len(self.cone) != 2:
                 raise InputError(f"{key} cone: a vertex needs the outward normals of its two edges")
             self.cone = (_unit(f"{key} cone[0]", self.cone[0]), _unit(f"{key} cone[1]", self.cone[1]))
+        if self.neighbours is not None:
+            if len(self.neighbours) != 2:
+                raise InputError(f"{key} neighbours: the outward normals of the edge's previous and next edges")
+            self.neighbours = tuple(_unit(f"{key} neighbours[{k}]", n) for k, n in enumerate(self.neighbours))
         if not (isinstance(self.depth_limit, (int, float)) and self.depth_limit == math.inf):
             self.depth_limit = require_nonnegative(f"{key} depth_limit", self.depth_limit)
         _require_type(f"{key} law", self.law, ContactLaw)
@@ -455,6 +463,8 @@ class VertexOnEdge(_PackedRelation):
             (row[C_CONE_1X], row[C_CONE_1Y]), (row[C_CONE_2X], row[C_CONE_2Y]) = self.cone
         row[C_TIE_WINS] = 1.0 if self.tie_wins else 0.0
         row[C_DEPTH_LIMIT] = self.depth_limit
+        if self.neighbours is not None:
+            (row[C_PREV_NX], row[C_PREV_NY]), (row[C_NEXT_NX], row[C_NEXT_NY]) = self.neighbours
         if self.vertex_body >= 0:
             return KIND_VERTEX_ON_EDGE, self.vertex_body, self.edge_body
         return KIND_FIXED_VERTEX_ON_EDGE, self.edge_body, -1

@@ -24,7 +24,9 @@ from .blocks import BlockOnIncline, PushedBlock, slope_motion
 from .bouncing_ball import BouncingBall, ball_height, rest_time
 from .collisions import BallRow, ball_velocities
 from .common import example_parser, first_slip_time, run, save_figure
+from .box_heap import BoxHeap
 from .disk import DiskOnIncline
+from .dominoes import Dominoes
 from .indeterminate import DiskPyramid, Ladder, WedgedRod
 from .painleve import PainleveRod
 from .rocking_block import RockingBlock, impact_rate_pairs
@@ -37,5 +39,5 @@ __all__ = [
     "RockingBlock", "PainleveRod", "BallRow", "ball_height", "rest_time", "slope_motion",
     "first_slip_time", "stick_slip_phases", "impact_rate_pairs", "ball_velocities", "save_figure",
     "example_parser", "Ladder", "WedgedRod", "DiskPyramid", "ShakenBlock", "BallOnShakenPlate",
-    "Woodpecker", "LimitCycle", "limit_cycle", "SliderCrank", "wall_switches",
+    "Woodpecker", "LimitCycle", "limit_cycle", "SliderCrank", "wall_switches", "Dominoes", "BoxHeap",
 ]

@@ -1,0 +1,28 @@
+"""A heap of boxes dropped into a bin (toys/box_heap.py), every pair of shapes searched: no box
+passes through another, the floor or a wall (separating axes over every pair, independent of the
+contact kernels), and the heap comes to rest. Compiled; a few seconds (the 50-box heap is
+benchmarks/bench_shapes.py --peers)."""
+import math
+
+import numpy as np
+
+import nonsmooth_rod as nr
+from nonsmooth_rod.model.collision import deepest_overlap
+from nonsmooth_rod.toys.box_heap import BoxHeap
+
+H = 1e-3
+
+
+def test_a_dropped_heap_of_boxes_rests_without_any_box_through_another():
+    heap = BoxHeap(n=12, columns=4)
+    scene = heap.scene()
+    assert len(scene.contacts) == 12 * 11 // 2 * 32 + 12 * 3 * 4  # every pair, every box on the floor and walls
+    q0, v0 = heap.initial_state()
+    lines = list(heap.obstacles().values())
+    assert deepest_overlap(scene.bodies, heap.shapes(), q0, lines) == 0.0
+    result = nr.simulate(scene, q0, v0, 1.5, "moreau-jean", h=H, save_every=0.005)
+    assert result.status == "ok", result.message[:200]
+    # no deeper than one step of travel at the fastest fall (from the top layer's height)
+    fastest = math.sqrt(2 * 9.81 * q0[1::3].max())
+    assert deepest_overlap(scene.bodies, heap.shapes(), result.trajectory.q, lines) < H * fastest
+    assert np.abs(result.trajectory.v[-1]).max() < 1e-6  # at rest
