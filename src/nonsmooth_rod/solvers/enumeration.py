@@ -34,10 +34,9 @@ from .kernel_base import (
     all_finite,
     step_residual,
 )
-from .problem import InfeasibleProblem, PlanarFrictionProblem
+from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,
+                      InfeasibleProblem, PlanarFrictionProblem)
 
-OPEN, STICK, SLIP_POS, SLIP_NEG = range(4)
-MODE_NAMES = ("open", "stick", "slip+", "slip-")
 
 # Default acceptance: complementarity_residual ≤ ACCEPT_TOL · scale (see enumerate_modes).
 ACCEPT_TOL = 1e-9
@@ -69,20 +68,20 @@ def _mode_system(W, q, lo, hi, modes, A, b):
         N = 2 * i
         T = N + 1
         mode = modes[i]
-        if mode == OPEN:
+        if mode == STATE_OPEN:
             A[N, N] = 1.0  # p_N = 0, p_T = 0
             A[T, T] = 1.0
             continue
         for j in range(n):  # u_N = 0
             A[N, j] = W[N, j]
         b[N] = -q[N]
-        if mode == STICK:  # u_T = 0
+        if mode == STATE_STICK:  # u_T = 0
             for j in range(n):
                 A[T, j] = W[T, j]
             b[T] = -q[T]
         else:  # p_T = bound · p_N
             A[T, T] = 1.0
-            A[T, N] = -(lo[i] if mode == SLIP_POS else hi[i])
+            A[T, N] = -(lo[i] if mode == STATE_SLIP_PLUS else hi[i])
 
 
 @jit
@@ -97,22 +96,22 @@ def _mode_inequalities(W, q, lo, hi, modes, G, h):
         T = N + 1
         r = 3 * i
         mode = modes[i]
-        if mode == OPEN:  # u_N ≥ 0
+        if mode == STATE_OPEN:  # u_N ≥ 0
             for j in range(n):
                 G[r, j] = W[N, j]
             h[r] = q[N]
         else:  # p_N ≥ 0
             G[r, N] = 1.0
             h[r] = 0.0
-        if mode == STICK:  # p_T − lo p_N ≥ 0, hi p_N − p_T ≥ 0
+        if mode == STATE_STICK:  # p_T − lo p_N ≥ 0, hi p_N − p_T ≥ 0
             G[r + 1, T] = 1.0
             G[r + 1, N] = -lo[i]
             G[r + 2, T] = -1.0
             G[r + 2, N] = hi[i]
             h[r + 1] = 0.0
             h[r + 2] = 0.0
-        elif mode == SLIP_POS or mode == SLIP_NEG:  # ±u_T ≥ 0
-            sign = 1.0 if mode == SLIP_POS else -1.0
+        elif mode == STATE_SLIP_PLUS or mode == STATE_SLIP_MINUS:  # ±u_T ≥ 0
+            sign = 1.0 if mode == STATE_SLIP_PLUS else -1.0
             for j in range(n):
                 G[r + 1, j] = sign * W[T, j]
             h[r + 1] = sign * q[T]
@@ -296,7 +295,7 @@ def mode_solutions(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, r
     _check_size(problem)
     modes, P, U, residuals, scales = _candidates(problem, rcond)
     return [
-        (tuple(MODE_NAMES[m] for m in modes[k]), P[k], U[k])
+        (tuple(CONTACT_STATES[m] for m in modes[k]), P[k], U[k])
         for k in np.flatnonzero(residuals <= tol * scales + RESIDUAL_FLOOR)
     ]
 
@@ -330,12 +329,12 @@ def enumerate_modes(problem: PlanarFrictionProblem, *, tol: float = ACCEPT_TOL, 
         best = int(np.argmin(residuals / scales))
         raise InfeasibleProblem(
             f"enum: none of the {len(modes)} mode combinations satisfies the step law; best "
-            f"{[MODE_NAMES[m] for m in modes[best]]} with residual {residuals[best]:.3e} "
+            f"{[CONTACT_STATES[m] for m in modes[best]]} with residual {residuals[best]:.3e} "
             f"(> {tol:.0e} × scale {scales[best]:.3e})"
         )
     return make_solution(
         problem, P[k], U[k], "enum", len(modes), float(residuals[k]),
-        modes=[MODE_NAMES[m] for m in modes[k]], n_solutions=int(n_valid),
+        modes=[CONTACT_STATES[m] for m in modes[k]], n_solutions=int(n_valid),
     )
 
 

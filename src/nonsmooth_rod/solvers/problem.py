@@ -163,6 +163,9 @@ def residual_scale(problem: PlanarFrictionProblem, p: np.ndarray, u: np.ndarray)
     return scale if scale > 0.0 else 1.0
 
 
+# A contact's state after a step, the one definition of the codes every solver and the loop use:
+# open, stick, slip+ (slip velocity u_T > 0), slip− (u_T < 0); CONTACT_STATES are their names.
+STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = range(4)
 CONTACT_STATES = ("open", "stick", "slip+", "slip-")
 
 

@@ -219,7 +219,8 @@ def _polish_active_set(problem: PlanarFrictionProblem, p: np.ndarray) -> np.ndar
     """
     import itertools
 
-    from .enumeration import OPEN, SLIP_NEG, SLIP_POS, STICK, _solve_modes
+    from .enumeration import _solve_modes
+    from .problem import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK
 
     u = problem.W @ p + problem.q
     p_scale = max(float(np.max(np.abs(p))), 1e-300)
@@ -229,9 +230,9 @@ def _polish_active_set(problem: PlanarFrictionProblem, p: np.ndarray) -> np.ndar
     choices = []
     for i in range(problem.n_contacts):
         if p[2 * i] <= 1e-9 * p_scale:
-            choices.append([OPEN])
+            choices.append([STATE_OPEN])
         else:
-            choices.append([STICK, SLIP_POS if u[2 * i + 1] >= 0.0 else SLIP_NEG])
+            choices.append([STATE_STICK, STATE_SLIP_PLUS if u[2 * i + 1] >= 0.0 else STATE_SLIP_MINUS])
     modes = np.array(list(itertools.product(*choices)))
     candidates = _solve_modes(problem, modes, 1e-12)
     best, best_residual = p, complementarity_residual(problem, p)

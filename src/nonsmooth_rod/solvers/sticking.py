@@ -28,8 +28,8 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit
+from .problem import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK
 
-STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
 MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
 # Touching, the impulse anywhere in the μs cone, any slip: sticking and sliding relaxed into one
 # mode (the pruning test of prefer_sticking).

@@ -32,14 +32,13 @@ from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER
                       carve, carve_matrix, fitting_scratch, lemke_interval, pgs_block, solve_enum, solve_interval,
                       solve_lemke_into, solve_pgs, solver_scratch)
 from ._common import interpreted
-from .problem import PlanarFrictionProblem, SolverError
+from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
+                      PlanarFrictionProblem, SolverError)
 from .sticking import coupled_components, gather_contacts, group_matrix, prefer_sticking_by_group, scatter_contacts
 
 COMPILED_SOLVERS = SOLVER_CODES  # solver name -> code of the compiled kernels
 
-# Contact state codes (API.md): open, stick, slip+, slip−.
-STATE_OPEN, STATE_STICK, STATE_SLIP_PLUS, STATE_SLIP_MINUS = 0, 1, 2, 3
-STATE_NAMES = ("open", "stick", "slip+", "slip-")
+STATE_NAMES = CONTACT_STATES  # (the codes' names, problem.py)
 # What the sign iteration does after a solve that was not consistent.
 NEXT_RETRY, NEXT_TRY_ZERO, NEXT_STOP = 0, 1, 2
 MAX_SOLVES = 6
