@@ -10,13 +10,13 @@ A step of size h from (q_k, v_k), for a packed scene (model.packing):
                  impacts, contact memory
 
 `run_steps` runs them for a range of steps with the packed forces (the whole run is one
-compiled call, whichever solver iparams names), plus an `extra` force — the step-wise loop that
-calls back a Python `applied_force` runs it one step a call with that force). Arrays are grouped in three tuples so every
-kernel compiles to one signature: model (scene), work (per-contact memory and scratch), out
-(records). model and work are built by `_model_and_work` in moreau_jean.py, out by `Window` in
-moreau_jean_records.py (the run in windows of rows). A fourth tuple, the scratch (`step_scratch`,
-S_* slots), holds a step's temporaries — the step problem, the solver's tableaux, the sparse W —
-allocated once per call of the loop, so that a step allocates nothing.
+compiled call, whichever solver iparams names), plus an `extra` force (the step-wise loop that
+calls back a Python `applied_force` runs it one step a call with that force). The data are named
+tuples: `Model` (the packed scene, built by `_model_and_work` in moreau_jean.py), `Work` (the
+contacts' memory and the step's kinematics), `Records` (the run's rows, `new_records`; the run goes
+in windows of rows, moreau_jean_records.Window) and `Scratch` (the step's temporaries, allocated once
+per call of the loop, so that a step allocates nothing). `_run` unpacks them once; the step's
+functions take the arrays they use and count no references (`_jit.jit_borrowing`).
 """
 from __future__ import annotations
 
@@ -30,8 +30,9 @@ from .._jit import jit, jit_borrowing
 
 
 def _inlined(function):
-    """jit, inlined into its callers at numba's IR level: the per-step kernels pass the packed
-    tuples (~30 arrays), and a call boundary costs ~300 ns of reference counting for them."""
+    """jit, inlined into its callers at numba's IR level: the small per-contact helpers (relative
+    velocities, a Delassus block, the force, a step's time), compiled as part of the function that
+    calls them (a borrowing one then counts no references for them either)."""
     if not _jit.ENABLED:
         return function
     import numba
@@ -290,9 +291,9 @@ def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_k
 
 
 @_inlined
-def _fill_block(blocks, k, hn, ht, index, i, j, minv):
-    """blocks[k] = the 2×2 block (N, T)ᵢ M⁻¹ (N, T)ⱼᵀ of the Delassus matrix: the bodies both
-    contacts touch. Scalar loops, no row views and inlined: a pile's ~800 blocks per step cost
+def _block_entries(hn, ht, index, i, j, minv):
+    """(NN, NT, TN, TT): the 2×2 block (N, T)ᵢ M⁻¹ (N, T)ⱼᵀ of the Delassus matrix, over the bodies
+    both contacts touch. Scalar loops, no row views and inlined: a pile's ~800 blocks per step cost
     ~110 ns each through views and calls (issue 26), most of the step."""
     nn, nt, tn, tt = 0.0, 0.0, 0.0, 0.0
     for side_i in range(2):
@@ -309,29 +310,7 @@ def _fill_block(blocks, k, hn, ht, index, i, j, minv):
                     nt += a_n * b_t
                     tn += a_t * b_n
                     tt += a_t * b_t
-    blocks[k, 0, 0], blocks[k, 0, 1], blocks[k, 1, 0], blocks[k, 1, 1] = nn, nt, tn, tt
-
-
-@_inlined
-def _fill_dense_block(W, a, b, hn, ht, index, i, j, minv):
-    """W's 2×2 block (a, b) of active contacts i, j, as _fill_block computes it (the same sums in
-    the same order), written in place."""
-    nn, nt, tn, tt = 0.0, 0.0, 0.0, 0.0
-    for side_i in range(2):
-        body = index[i, CI_BODY_A + side_i]
-        if body < 0:
-            continue
-        for side_j in range(2):
-            if index[j, CI_BODY_A + side_j] == body:
-                for d in range(3):
-                    w = minv[3 * body + d]
-                    a_n, a_t = hn[i, 3 * side_i + d] * w, ht[i, 3 * side_i + d] * w
-                    b_n, b_t = hn[j, 3 * side_j + d], ht[j, 3 * side_j + d]
-                    nn += a_n * b_n
-                    nt += a_n * b_t
-                    tn += a_t * b_n
-                    tt += a_t * b_t
-    W[2 * a, 2 * b], W[2 * a, 2 * b + 1], W[2 * a + 1, 2 * b], W[2 * a + 1, 2 * b + 1] = nn, nt, tn, tt
+    return nn, nt, tn, tt
 
 
 @jit
@@ -390,7 +369,9 @@ def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
                         seen[b] = a
                         if sweep == 1:
                             indices[indptr[a] + n] = b
-                            _fill_block(blocks, indptr[a] + n, hn, ht, index, active[a], active[b], minv)
+                            k = indptr[a] + n
+                            blocks[k, 0, 0], blocks[k, 0, 1], blocks[k, 1, 0], blocks[k, 1, 1] = _block_entries(
+                                hn, ht, index, active[a], active[b], minv)
                         n += 1
             if sweep == 0:
                 indptr[a + 1] = indptr[a] + n
@@ -442,7 +423,8 @@ def assemble_arrays(params, na, qk, vk, minv, table, index, joints, joint_buffer
         i = active[a]
         for b in range(na if W.shape[0] > 0 else 0):  # dense W: for lemke and enum
             j = active[b]
-            _fill_dense_block(W, a, b, hn, ht, index, i, j, minv)
+            W[2 * a, 2 * b], W[2 * a, 2 * b + 1], W[2 * a + 1, 2 * b], W[2 * a + 1, 2 * b + 1] = _block_entries(
+                hn, ht, index, i, j, minv)
         q_step[2 * a + 1] = relative_slip_velocity(table, hn, ht, index, i, v_free, False)
         # only a contact at rest — loaded in the previous step, or not slipping at the step's start —
         # is held by a search over admissible splits (sticking.py); one grazing a rolling
