@@ -117,3 +117,53 @@ def test_a_run_without_a_file_describes_its_motions_as_the_file_would():
     assert data["lines"][0]["motion"] == {"kind": "harmonic", "amplitude": [0.0, 0.01], "frequency_hz": 8.0,
                                           "phase_deg": pytest.approx(90.0)}
     assert data["bodies"][1]["motion"] == PLATE["bodies"][1]["motion"] and "motion" not in data["bodies"][0]
+
+
+SPLINE = {"kind": "table", "times": [0.0, 0.5, 1.0, 2.0], "positions": [[0.0, 0.0], [0.0, 0.1], [0.1, 0.0], [0.0, 0.0]],
+          "interpolation": "spline"}
+
+
+def test_a_spline_table_reads_from_a_file_and_is_described_as_the_file_would():
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.result_files import scene_description
+
+    data = copy.deepcopy(PLATE)
+    data["bodies"][1]["motion"] = copy.deepcopy(SPLINE)
+    sf = parse_scene(data)
+    assert sf.scene.driven == [DrivenBody(1, Tabulated(SPLINE["times"], SPLINE["positions"], "spline"))]
+    assert parse_scene(_with("bodies.shaker.motion.interpolation", '"linear"')).scene.driven[0].motion.interpolation \
+        == "linear"
+    result = nr.simulate(sf.scene, sf.q0, sf.v0, 0.002, h=1e-3)
+    assert scene_description(result)["bodies"][1]["motion"] == SPLINE
+
+
+SPLINE_BAD = [
+    ("bodies.shaker.motion.interpolation", '"cubic"',
+     "bodies.shaker.motion.interpolation: must be one of linear, spline; got 'cubic'"),
+    ("bodies.shaker.motion.interpolation", "3", "bodies.shaker.motion.interpolation: must be a string"),
+    ("bodies.shaker.motion.interpolation", '"spline"',
+     "bodies.shaker.motion: a spline motion table needs at least 4 rows (not-a-knot cubic), got 2"),
+    ("lines.plate.motion.interpolation", '"spline"', "lines.plate.motion.interpolation: unknown key"),
+]
+
+
+@pytest.mark.parametrize("path, value, message", SPLINE_BAD, ids=[f"{p}={v}" for p, v, _ in SPLINE_BAD])
+def test_a_bad_interpolation_is_one_line_naming_the_key(path, value, message):
+    with pytest.raises(InputError) as err:
+        parse_scene(_with(path, value), source="my.toml")
+    text = str(err.value)
+    assert text.startswith("my.toml: ") and message in text and "\n" not in text, text
+
+
+def test_a_bad_interpolation_exits_2_with_one_line(tmp_path, capsys):
+    from nonsmooth_rod.cli import main
+
+    scene = tmp_path / "bad.toml"
+    text = (SCENES / "shaken_block.toml").read_text()
+    scene.write_text(text.replace('{ kind = "harmonic", amplitude = [0.02, 0.0], frequency_hz = 2.0, phase_deg = 0.0 }',
+                                  '{ kind = "table", times = [0, 1], positions = [[0, 0], [0.1, 0]], '
+                                  'interpolation = "cubic" }'))
+    assert main(["run", str(scene), "--out", str(tmp_path / "o"), "--no-plot", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "lines.floor.motion.interpolation: must be one of linear, spline" in err
+    assert len(err.strip().splitlines()) == 1

@@ -158,7 +158,8 @@ def _motion_data(motion) -> dict:
                            "frequency_hz": motion.frequency_hz, "phase_deg": math.degrees(motion.phase)}}
     if isinstance(motion, Tabulated):
         return {"motion": {"kind": "table", "times": list(motion.times),
-                           "positions": [list(p) for p in motion.positions]}}
+                           "positions": [list(p) for p in motion.positions]}
+                | ({"interpolation": motion.interpolation} if motion.interpolation != "linear" else {})}
     return {"motion": {"kind": "python", "function": _plain(motion.function)}}
 
 

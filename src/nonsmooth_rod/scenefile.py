@@ -25,7 +25,7 @@ from .model import shapes
 from .model.body import RigidBody
 from .model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge
 from .model.laws import ContactLaw
-from .model.motion import DrivenBody, Harmonic, Tabulated
+from .model.motion import INTERPOLATIONS, DrivenBody, Harmonic, Tabulated
 from .scene_forces import FORCE_KINDS, build_force, make_scene
 from .validation import MAX_INTEGER, MAX_STATE, InputError, quoted, require_finite
 
@@ -51,7 +51,8 @@ COLLISION_KEYS = ("collide", "group", "collides_with")  # scene_collisions.py: n
 LINE_KEYS = ("name", "point", "angle_deg", "velocity", "length", "motion")
 SEGMENT_KEYS = ("name", "a", "b", "motion")
 # A prescribed motion (model/motion.py) of a line, segment or body: a displacement from its placement.
-MOTION_KEYS = {"harmonic": ("kind", "amplitude", "frequency_hz", "phase_deg"), "table": ("kind", "times", "positions")}
+MOTION_KEYS = {"harmonic": ("kind", "amplitude", "frequency_hz", "phase_deg"),
+               "table": ("kind", "times", "positions", "interpolation")}
 LAW_KEYS = ("mu_s", "mu_d", "restitution")
 CONTACT_KEYS = {
     "disk-on-line": ("kind", "name", "body", "offset", "radius", "line", "law"),
@@ -368,7 +369,7 @@ def _motion_of(w, m, key, widths):
         raise w.error(f"{key}.positions", f"must be a list of {len(times)} positions, one per time")
     n = len(rows[0]) if isinstance(rows[0], list) and len(rows[0]) in widths else widths[0]
     positions = [_vector(w, {f"[{i}]": r}, f"[{i}]", f"{key}.positions", n) for i, r in enumerate(rows)]
-    return Tabulated(times, positions)
+    return Tabulated(times, positions, _text(w, m, "interpolation", key, "linear", choices=INTERPOLATIONS))
 
 
 def _driven_bodies(w, data, body_names) -> list:

@@ -4,21 +4,25 @@ A motion is a displacement d(t) = (dx, dy, dθ) from the thing's initial placeme
 velocity ḋ(t):
 
     Harmonic(amplitude, frequency_hz, phase)   d = amplitude · sin(2π f t + φ)
-    Tabulated(times, positions)                 d linear between the rows (held before the first
-                                                and after the last time); ḋ the row's slope
+    Tabulated(times, positions, interpolation)  d through the rows: "linear" (ḋ the row's slope) or
+                                                "spline" (a not-a-knot cubic spline, ḋ its derivative);
+                                                held at the first/last row (ḋ = 0) outside the times
     Prescribed(function)                        function(t) -> (d, ḋ), Python (the step-wise loop)
 
 A line or segment takes a translation (two components: it does not turn); a body takes two or
 three (x, y, θ). The compiled Moreau–Jean loop evaluates the harmonic and tabulated motions with
 `motion_kernel` from a packed table (like model/forces.py's tables); the Python classes' `at`
-reads the same kernel, so the two cannot disagree.
+reads the same kernel, so the two cannot disagree. A table of either interpolation is packed as a
+piecewise cubic (its linear, quadratic and cubic coefficients beside each row's position; a linear
+table's higher ones zero), so one kernel evaluates both.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from .._jit import jit, jitable
 from ..validation import InputError, quoted, require_finite, require_index, require_nonnegative
@@ -31,6 +35,13 @@ N_MOTION_COLUMNS = 8
 # Columns of the per-step evaluation `now`: d and ḋ at the step's start, d and ḋ at its end.
 NOW_START, NOW_START_VELOCITY, NOW_END, NOW_VELOCITY = 0, 3, 6, 9
 N_NOW_COLUMNS = 12
+# Columns of the packed table values: row i's position (x, y, θ), then the coefficients of the
+# cubic d(t) = d_i + c₁ s + c₂ s² + c₃ s³ (s = t − t_i, three columns each) on [t_i, t_{i+1}].
+VALUE_POSITION, VALUE_LINEAR, VALUE_QUADRATIC, VALUE_CUBIC = 0, 3, 6, 9
+N_VALUE_COLUMNS = 12
+INTERPOLATIONS = ("linear", "spline")
+SPLINE_BOUNDARY = "not-a-knot"  # scipy.interpolate.CubicSpline's bc_type: exact for a cubic
+MIN_SPLINE_ROWS = 4  # a not-a-knot spline needs 4 rows to be a true cubic (scipy: 2 a line, 3 a parabola)
 
 
 def _components(name: str, values, allowed) -> tuple[float, ...]:
@@ -75,12 +86,19 @@ class Harmonic:
 
 @dataclass(frozen=True)
 class Tabulated:
-    """d(t) linear between (times[i], positions[i]); positions rows of 2 or 3 numbers."""
+    """d(t) through (times[i], positions[i]), positions rows of 2 or 3 numbers: linear between the
+    rows, or a cubic spline (interpolation="spline": scipy's CubicSpline per coordinate, not-a-knot
+    ends, at least 4 rows); held at the first row before times[0] and the last after times[-1]."""
 
     times: tuple
     positions: tuple
+    interpolation: str = "linear"
+    coefficients: np.ndarray = field(init=False, repr=False, compare=False)  # (rows, N_VALUE_COLUMNS)
 
     def __post_init__(self):
+        if self.interpolation not in INTERPOLATIONS:
+            raise InputError(f"motion interpolation must be one of {', '.join(INTERPOLATIONS)}, "
+                             f"got {quoted(self.interpolation)}")
         try:
             times = list(self.times)
         except TypeError:
@@ -100,8 +118,12 @@ class Tabulated:
         width = len(rows[0])
         positions = tuple(_components(f"motion positions[{i}]", r, (width,) if i else (2, 3))
                           for i, r in enumerate(rows))
+        if self.interpolation == "spline" and len(times) < MIN_SPLINE_ROWS:
+            raise InputError(f"a spline motion table needs at least {MIN_SPLINE_ROWS} rows ({SPLINE_BOUNDARY} "
+                             f"cubic), got {len(times)}")
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "positions", positions)
+        object.__setattr__(self, "coefficients", _piecewise_cubic(times, positions, self.interpolation))
 
     @property
     def n_components(self) -> int:
@@ -110,10 +132,31 @@ class Tabulated:
     def pack(self, row, times: list, values: list) -> None:
         row[MO_KIND], row[MO_START], row[MO_COUNT] = MOTION_TABLE, len(times), len(self.times)
         times.extend(self.times)
-        values.extend(tuple(p) + (0.0,) * (3 - len(p)) for p in self.positions)
+        values.extend(self.coefficients)
 
     def at(self, t: float):
         return _packed_at(self, t)
+
+
+def _piecewise_cubic(times, positions, interpolation: str) -> np.ndarray:
+    """The packed values of a table (rows, N_VALUE_COLUMNS): each row's position and the
+    coefficients of the cubic from it to the next row (the last row's zero: the table is held)."""
+    values = np.zeros((len(times), N_VALUE_COLUMNS))
+    y = np.array([tuple(p) + (0.0,) * (3 - len(p)) for p in positions])
+    values[:, VALUE_POSITION:VALUE_POSITION + 3] = y
+    if len(times) < 2:
+        return values
+    with np.errstate(all="ignore"):  # an overflow is refused below
+        if interpolation == "linear":
+            values[:-1, VALUE_LINEAR:VALUE_LINEAR + 3] = np.diff(y, axis=0) / np.diff(times)[:, None]
+        else:
+            c = CubicSpline(times, y, bc_type=SPLINE_BOUNDARY).c  # (4, rows − 1, 3): s³, s², s, 1
+            for column, power in ((VALUE_CUBIC, 0), (VALUE_QUADRATIC, 1), (VALUE_LINEAR, 2)):
+                values[:-1, column:column + 3] = c[power]
+    if not np.all(np.isfinite(values)):
+        raise InputError(f"motion positions change too fast between their times: the table's {interpolation} "
+                         f"slopes overflow")
+    return values
 
 
 @dataclass(frozen=True)
@@ -185,7 +228,7 @@ def pack_motions(motions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     values: list = []
     for i, motion in enumerate(motions):
         motion.pack(table[i], times, values)
-    return table, np.array(times, dtype=float), np.array(values, dtype=float).reshape(-1, 3)
+    return table, np.array(times, dtype=float), np.array(values, dtype=float).reshape(-1, N_VALUE_COLUMNS)
 
 
 def _packed_at(motion, t: float):
@@ -197,7 +240,8 @@ def _packed_at(motion, t: float):
 
 @jitable
 def motion_kernel(t, row, times, values, out, o):
-    """d(t) into out[o:o+3] and ḋ(t) into out[o+3:o+6] for a harmonic or tabulated motion."""
+    """d(t) into out[o:o+3] and ḋ(t) into out[o+3:o+6] for a harmonic or tabulated motion (a table
+    is a piecewise cubic: its row's position plus c₁ s + c₂ s² + c₃ s³, ḋ = c₁ + 2 c₂ s + 3 c₃ s²)."""
     if row[MO_KIND] == MOTION_HARMONIC:
         arg = row[MO_OMEGA] * t + row[MO_PHASE]
         s, c = math.sin(arg), row[MO_OMEGA] * math.cos(arg)
@@ -209,15 +253,11 @@ def motion_kernel(t, row, times, values, out, o):
     j = start + np.searchsorted(times[start:start + n], t, side="right") - 1  # the row at or before t
     inside = start <= j < start + n - 1
     j = min(max(j, start), start + n - 1)
+    s = t - times[j] if inside else 0.0  # held outside the times: the row's position, ḋ = 0
     for d in range(3):
-        out[o + d] = values[j, d]
-        out[o + 3 + d] = 0.0
-    if inside:
-        span = times[j + 1] - times[j]
-        for d in range(3):
-            slope = (values[j + 1, d] - values[j, d]) / span
-            out[o + d] = values[j, d] + slope * (t - times[j])
-            out[o + 3 + d] = slope
+        c1, c2, c3 = values[j, VALUE_LINEAR + d], values[j, VALUE_QUADRATIC + d], values[j, VALUE_CUBIC + d]
+        out[o + d] = values[j, VALUE_POSITION + d] + ((c3 * s + c2) * s + c1) * s
+        out[o + 3 + d] = ((3.0 * c3 * s + 2.0 * c2) * s + c1) if inside else 0.0
 
 
 @jit
