@@ -4,8 +4,17 @@ import os
 from nonsmooth_rod import _jit
 
 
+def _unset_cache_dir(monkeypatch):
+    """NUMBA_CACHE_DIR absent for the test, and absent again after it: _choose_cache_dir may set it,
+    and a bare delenv of an unset variable records nothing to undo — the setting leaked into the
+    worker's environment, and every later subprocess (the memory benchmark's runs) compiled the
+    engine from scratch into this test's folder (~2.5 min of a cold CI run)."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", "")  # records the original state, restored after the test
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
+
+
 def test_a_read_only_package_folder_sends_the_cache_to_the_user_folder(monkeypatch, tmp_path):
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    _unset_cache_dir(monkeypatch)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     monkeypatch.setattr(_jit.os, "access", lambda path, mode: False)
     _jit._choose_cache_dir()
@@ -21,7 +30,7 @@ def test_numba_cache_dir_set_by_the_user_wins(monkeypatch, tmp_path):
 
 
 def test_a_writable_package_folder_keeps_numbas_default(monkeypatch):
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    _unset_cache_dir(monkeypatch)
     monkeypatch.setattr(_jit.os, "access", lambda path, mode: True)
     _jit._choose_cache_dir()
     assert "NUMBA_CACHE_DIR" not in os.environ
@@ -144,3 +153,14 @@ def test_without_numba_the_library_warns_once_for_a_moreau_jean_run(monkeypatch)
         nr.simulate(ball.scene(), *ball.initial_state(), 0.01, h=1e-3)
     assert [str(w.message) for w in caught] == [_jit.NO_NUMBA_MESSAGE]
     assert caught[0].category is RuntimeWarning and caught[0].filename == __file__  # points at the caller
+
+
+def test_the_cache_dir_chosen_in_a_test_does_not_outlive_it(monkeypatch, tmp_path):
+    before = os.environ.get("NUMBA_CACHE_DIR")
+    with monkeypatch.context() as patch:
+        _unset_cache_dir(patch)
+        patch.setenv("XDG_CACHE_HOME", str(tmp_path))
+        patch.setattr(_jit.os, "access", lambda path, mode: False)
+        _jit._choose_cache_dir()
+        assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / "nonsmooth-rod" / "numba")
+    assert os.environ.get("NUMBA_CACHE_DIR") == before
