@@ -36,7 +36,8 @@ PEER_SETTINGS = {
     "mujoco": "planar (slide x, slide z, hinge y); Newton solver, 100 iterations, tol 1e-8, pyramidal cone, "
               "condim 3, default solref/solimp",
     "bullet": "3-D spheres, box walls, DIRECT mode; default SI solver, 50 iterations",
-    "pymunk10": "Chipmunk2D, space.iterations = 10 (default), friction sqrt(mu) per shape",
+    "pymunk10": ("Chipmunk2D, space.iterations = 10 (default), collision_slop 1e-4 m (default 0.1), "
+                 "friction sqrt(mu) per shape"),
     "pymunk100": "Chipmunk2D, space.iterations = 100",
 }
 
@@ -105,6 +106,18 @@ def pybullet_step_us(scene, h, steps, repeats):
         pb.disconnect(physicsClientId=client)
 
 
+def _pymunk_space(pymunk, iterations, lines, friction):
+    """A pymunk space with `iterations`, gravity, a collision slop of 0.1 mm (its default, 0.1, lets
+    shapes overlap by up to 10 cm: not the same scene) and the static segments `lines` ((a, b) pairs)."""
+    space = pymunk.Space()
+    space.iterations, space.collision_slop, space.gravity = iterations, 1e-4, (0.0, -9.81)
+    for a, b in lines:
+        segment = pymunk.Segment(space.static_body, a, b, 0.0)
+        segment.friction, segment.elasticity = friction, 0.0
+        space.add(segment)
+    return space
+
+
 def pymunk_step_us(scene, h, steps, repeats, iterations):
     """space.step per step with `iterations`, or None when pymunk is not installed."""
     try:
@@ -116,17 +129,11 @@ def pymunk_step_us(scene, h, steps, repeats, iterations):
     holder = {}
 
     def reset():
-        space = pymunk.Space()
-        space.iterations = iterations
-        space.gravity = (0.0, -9.81)
         lines = [((-50.0, 0.0), (50.0, 0.0))]
         if scene["walls"]:
             left, right = scene["walls"]
             lines += [((left, 0.0), (left, 50.0)), ((right, 0.0), (right, 50.0))]
-        for a, b in lines:
-            segment = pymunk.Segment(space.static_body, a, b, 0.0)
-            segment.friction, segment.elasticity = friction, 0.0
-            space.add(segment)
+        space = _pymunk_space(pymunk, iterations, lines, friction)
         for (x, y), (vx, vy, w) in zip(scene["centres"], scene["v0"]):
             body = pymunk.Body(m, 0.4 * m * r * r)
             body.position, body.velocity, body.angular_velocity = (x, y), (vx, vy), w
@@ -208,12 +215,8 @@ def pymunk_boxes_step_us(scene, h, steps, repeats, iterations):
     holder = {}
 
     def reset():
-        space = pymunk.Space()
-        space.iterations, space.collision_slop, space.gravity = iterations, 1e-4, (0.0, -9.81)
-        for point, angle in scene["lines"]:
-            segment = pymunk.Segment(space.static_body, *_line_ends(point, angle), 0.0)
-            segment.friction, segment.elasticity = scene["mu_line"] / math.sqrt(scene["mu"]), 0.0
-            space.add(segment)
+        space = _pymunk_space(pymunk, iterations, [_line_ends(point, angle) for point, angle in scene["lines"]],
+                              scene["mu_line"] / math.sqrt(scene["mu"]))
         for x, y, th, vx, vy, om in scene["boxes"]:
             body = pymunk.Body(m, pymunk.moment_for_box(m, (w, ht)))
             body.position, body.angle, body.velocity, body.angular_velocity = (x, y), th, (vx, vy), om
