@@ -713,39 +713,38 @@ def step_impulses(na, s_floats, s_states):
 
 
 @jit_borrowing
-def step_arrays(solver_code, k, f, params, iparams,
-                minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys,
-                pair_contact, motions, motion_times, motion_values, motion_now, driven, driven_origin, joints,
-                gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, joint_buffer,
-                q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step, impact_contact, counters,
-                joint_impulse,
-                s_floats, s_states, s_w, s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats):
-    """One whole step with generalised force f, on the arrays of Model, Work, Records and Scratch
-    in their order; returns a run status (the solver read from its code at run time)."""
-    qk, vk = q[k], v[k]
-    if motions.shape[0] > 0:  # (a scene without driven obstacles or bodies skips their calls)
-        drive_arrays(k, params, table, motions, motion_times, motion_values, motion_now)
-    na = begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_keys, pair_contact, joints,
-                      joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate)
+def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
+    """One whole step with generalised force f on the named data (Model, Work, Records, Scratch);
+    returns a run status (the solver read from its code at run time). Compiled without reference
+    counting, the tuples cost nothing to pass: each function below takes the arrays it uses."""
+    m, w, o = model, work, out
+    qk, vk = o.q[k], o.v[k]
+    if m.motions.shape[0] > 0:  # (a scene without driven obstacles or bodies skips their calls)
+        drive_arrays(k, params, m.contacts, m.motions, m.motion_times, m.motion_values, m.motion_now)
+    na = begin_arrays(params, qk, vk, f, m.minv, m.contacts, m.contact_index, m.disks, m.disk_body, m.pair_keys,
+                      m.pair_contact, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht, w.active, w.was_closed,
+                      w.v_free, w.a_free, w.candidate)
     if na < 0:
-        return geometry_failure(na, table.shape[0], counters)
-    if driven.shape[0] > 0:
-        hold_driven_arrays(driven, motion_now, v_free)
-    p, u, states = step_impulses(na, s_floats, s_states)  # (empty without contacts)
+        return geometry_failure(na, m.contacts.shape[0], o.counters)
+    if m.driven.shape[0] > 0:
+        hold_driven_arrays(m.driven, m.motion_now, w.v_free)
+    p, u, states = step_impulses(na, scratch.floats, scratch.states)  # (empty without contacts)
     if na > 0:
         status = solve_arrays(
-            solver_code, k, params, iparams, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht,
-            active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, s_floats, s_w,
-            s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats, p, u, states)
+            solver_code, k, params, iparams, na, qk, vk, m.minv, m.contacts, m.contact_index, m.joints,
+            w.joint_buffer, w.gaps, w.hn, w.ht, w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free,
+            o.p_normal, o.p_tangent, o.counters, scratch.floats, scratch.W, scratch.solver_floats,
+            scratch.solver_ints, scratch.sparse_ints, scratch.sparse_floats, p, u, states)
         if status != KERNEL_SOLVED:
-            counters[K_SOLVER_STATUS] = status
+            o.counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
-    status = finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, index, pair_keys, joints,
-                           joint_buffer, gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free,
-                           candidate, q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step,
-                           impact_contact, counters, joint_impulse)
-    if driven.shape[0] > 0:
-        place_driven_arrays(k, driven, driven_origin, motion_now, q, v)
+    status = finish_arrays(k, params, iparams, na, p, u, states, qk, vk, m.minv, m.contacts, m.contact_index,
+                           m.pair_keys, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht, w.active,
+                           w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o.q, o.v,
+                           o.p_normal, o.p_tangent, o.slip, o.states, o.impact_t, o.impact_step, o.impact_contact,
+                           o.counters, o.joint_impulse)
+    if m.driven.shape[0] > 0:
+        place_driven_arrays(k, m.driven, m.driven_origin, m.motion_now, o.q, o.v)
     return status
 
 
@@ -832,32 +831,18 @@ def end_of_step(k, status, counters):
 
 @jit
 def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
-    """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call,
-    on the tuples' arrays unpacked here once (run_arrays)."""
+    """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call."""
     # what the loop needs besides the tuples, allocated here: run_arrays counts no references
     f, ring = np.empty(model.minv.shape[0]), np.empty((3, 3, model.contacts.shape[0]))
     return run_arrays(solver_code, k_start, k_end, params, iparams, extra, step_scratch(solver_code, model), f, ring,
-                      np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64),
-                      model.minv, model.weight, model.contacts, model.contact_index, model.force_table,
-                      model.force_index, model.force_times, model.force_values, model.disks, model.disk_body,
-                      model.pair_keys, model.pair_contact, model.motions, model.motion_times, model.motion_values,
-                      model.motion_now, model.driven, model.driven_origin, model.joints, work.gaps, work.drifts,
-                      work.hn, work.ht, work.active, work.was_closed, work.grazing, work.slip_sign, work.v_free,
-                      work.a_free, work.candidate, work.joint_buffer, out.q, out.v, out.p_normal, out.p_tangent,
-                      out.slip, out.states, out.impact_t, out.impact_step, out.impact_contact, out.counters,
-                      out.joint_impulse)
+                      np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64), model, work, out)
 
 
 @jit_borrowing
-def run_arrays(solver_code, k_start, k_end, params, iparams, extra, scratch, f, memory, before,
-               minv, weight, table, index, ftable, findex, ftimes, fvalues, disks, disk_body, pair_keys,
-               pair_contact, motions, motion_times, motion_values, motion_now, driven, driven_origin, joints,
-               gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, joint_buffer,
-               q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step, impact_contact, counters,
-               joint_impulse):
-    """The loop over the steps, on Model's, Work's and Records' arrays in their order; f: the
-    force's array, memory and before: the rest's ring (below)."""
-    s_floats, s_states, s_w, s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats = scratch
+def run_arrays(solver_code, k_start, k_end, params, iparams, extra, scratch, f, memory, before, model, work, out):
+    """The loop over the steps on the named data; f: the force's array, memory and before: the
+    rest's ring (below)."""
+    m, o = model, out
     # The contacts' memory after each of the last three steps and the solver's counters before
     # them (a ring by step): what _fixed_period compares — only where a rest can be repeated (not
     # a time-varying scene, nor the one-step calls of the step-wise loop).
@@ -866,28 +851,31 @@ def run_arrays(solver_code, k_start, k_end, params, iparams, extra, scratch, f, 
     while k < k_end:
         if repeats:
             for c in range(len(REPEATED_COUNTERS)):
-                before[k % 3, c] = counters[REPEATED_COUNTERS[c]]
-        _packed_force(k, params, weight, ftable, findex, ftimes, fvalues, q, v, f)
+                before[k % 3, c] = o.counters[REPEATED_COUNTERS[c]]
+        _packed_force(k, params, m.weight, m.force_table, m.force_index, m.force_times, m.force_values, o.q, o.v, f)
         for d in range(extra.shape[0]):
             f[d] += extra[d]
-        status = step_arrays(
-            solver_code, k, f, params, iparams, minv, weight, table, index, ftable, findex, ftimes, fvalues, disks,
-            disk_body, pair_keys, pair_contact, motions, motion_times, motion_values, motion_now, driven,
-            driven_origin, joints, gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free,
-            candidate, joint_buffer, q, v, p_normal, p_tangent, slip, state_rec, impact_t, impact_step,
-            impact_contact, counters, joint_impulse, s_floats, s_states, s_w, s_solver_floats, s_solver_ints,
-            s_sparse_ints, s_sparse_floats)
-        if end_of_step(k, status, counters) != RUN_OK:
-            return counters[K_STATUS]
+        status = step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch)
+        if end_of_step(k, status, o.counters) != RUN_OK:
+            return o.counters[K_STATUS]
         if repeats:
-            for i in range(memory.shape[2]):
-                memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = was_closed[i], grazing[i], slip_sign[i]
-            period = _fixed_period(k, k - k_start + 1, q, v, p_normal, p_tangent, memory) if k + 1 < k_end else 0
-            if period > 0:
-                k = _repeat_period(k, k_end, period, q, v, p_normal, p_tangent, slip, state_rec, joint_impulse,
-                                   counters, was_closed, grazing, slip_sign, memory, before)
+            k = _after_step(k, k_start, k_end, work, out, memory, before)
         k += 1
     return RUN_OK
+
+
+@jit_borrowing
+def _after_step(k, k_start, k_end, work, out, memory, before):
+    """The rest's bookkeeping after step k: the contacts' memory into the ring, and a rest found
+    repeated to k_end (returns the last step so filled, else k)."""
+    w, o = work, out
+    for i in range(memory.shape[2]):
+        memory[k % 3, 0, i], memory[k % 3, 1, i], memory[k % 3, 2, i] = w.was_closed[i], w.grazing[i], w.slip_sign[i]
+    period = _fixed_period(k, k - k_start + 1, o.q, o.v, o.p_normal, o.p_tangent, memory) if k + 1 < k_end else 0
+    if period > 0:
+        return _repeat_period(k, k_end, period, o.q, o.v, o.p_normal, o.p_tangent, o.slip, o.states, o.joint_impulse,
+                              o.counters, w.was_closed, w.grazing, w.slip_sign, memory, before)
+    return k
 
 
 @jit
