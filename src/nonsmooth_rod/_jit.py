@@ -96,6 +96,19 @@ def jit_borrowing(function):
     return numba.njit(cache=True, _nrt=False)(function)
 
 
+def jit_inline(function):
+    """jit, inlined into its callers at numba's IR level: small helpers (a scratch view, a
+    relative velocity, a Delassus block) compiled as part of the function that calls them, with
+    its reference counting or without it (in a borrowing caller they count nothing either)."""
+    if not ENABLED:
+        return function
+    import numba
+
+    if not _purged:
+        purge_stale_kernels()
+    return numba.njit(cache=True, inline="always")(function)
+
+
 def jitable(function):
     """A kernel both ways: plain Python when Python calls it (it never waits for a compile), and
     compiled into the jitted kernels that call it (numba's register_jitable). For code that the

@@ -29,15 +29,7 @@ from .. import _jit
 from .._jit import jit, jit_borrowing
 
 
-def _inlined(function):
-    """jit, inlined into its callers at numba's IR level: the small per-contact helpers (relative
-    velocities, a Delassus block, the force, a step's time), compiled as part of the function that
-    calls them (a borrowing one then counts no references for them either)."""
-    if not _jit.ENABLED:
-        return function
-    import numba
-
-    return numba.njit(cache=True, inline="always")(function)
+_inlined = _jit.jit_inline  # the small per-contact helpers, compiled into the step's functions
 from ..model.contact_kernels import (C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
                                       KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
 from ..model.forces import accumulate_forces
@@ -45,7 +37,8 @@ from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
                              contact_kinematics, drive_contacts, row_dot)
-from ..solvers.kernels import SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, solver_scratch
+from ..solvers.kernels import (SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, fitting_scratch,
+                               solver_scratch)
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
                          project_positions)
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
@@ -690,9 +683,10 @@ def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index
     _warm_start(k, na, active, was_closed, p_normal, p_tangent, p)
     if sparse:
         indptr, indices, blocks = delassus_blocks(na, minv, index, hn, ht, active, s_sparse_ints, s_sparse_floats)
+        floats, ints = fitting_scratch(s_solver_floats, s_solver_ints, na)
         status, solves, iterations, consistent, fallbacks = two_coefficient_into(
             solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL],
-            iparams[I_MAX_ITER], p, u, states, s_solver_floats, s_solver_ints)
+            iparams[I_MAX_ITER], p, u, states, floats, ints)
     else:  # lemke, enum: one group of coupled contacts at a time (their cost grows with the group)
         status, solves, iterations, consistent, fallbacks = two_coefficient_by_group(
             solver_code, W, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL], iparams[I_MAX_ITER], p, u,

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 
 # Status codes.
 KERNEL_SOLVED = 0
@@ -106,13 +106,14 @@ def fitting_scratch(floats, ints, n_contacts):
     return solver_scratch(n_contacts)
 
 
-@jit
+# Inlined: a view made in a borrowing caller (the step's hot path) then counts no reference.
+@jit_inline
 def carve(buffer, at, n):
     """(buffer[at:at + n], at + n): the next n entries of a scratch buffer."""
     return buffer[at:at + n], at + n
 
 
-@jit
+@jit_inline
 def carve_matrix(buffer, at, rows, cols):
     """(the next rows × cols entries as a C-contiguous matrix, the offset after them)."""
     return buffer[at:at + rows * cols].reshape((rows, cols)), at + rows * cols

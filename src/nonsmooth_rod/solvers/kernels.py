@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 from .enumeration import enum_interval
 from .gauss_seidel import dense_to_blocks, pgs_block, pgs_dense
 from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into
@@ -53,12 +53,13 @@ from .kernel_base import (
 )
 
 
-@jit
+@jit_borrowing
 def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
     """Lemke on the interval LCP, then on the cone LCP if that fails (as lemke_friction does),
     in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0] contacts).
 
     Returns (status, pivots, residual); the first formulation's failure status when both fail.
+    Compiled without reference counting (the step's hot path; it allocates nothing).
     """
     if rtol <= 0.0:
         rtol = DEFAULT_RTOL
@@ -68,17 +69,14 @@ def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
     for attempt in range(2):
         formulation = INTERVAL if attempt == 0 else CONE
         limit = max_pivots if max_pivots > 0 else default_max_pivots((3 + attempt) * lo.shape[0])
-        p_new, u_new, residual, status, pivots, norms = _lemke_friction_into(
-            W, q, lo, hi, limit, formulation, floats, ints)
-        scale = norms[2] if norms[2] > 0.0 else 1.0
-        if status == SOLVED and residual <= rtol * scale:
-            p[:] = p_new
-            u[:] = u_new
+        residual, status, pivots, q_norm, W_norm, scale = _lemke_friction_into(W, q, lo, hi, limit, formulation,
+                                                                              floats, ints, p, u)
+        if status == SOLVED and residual <= rtol * (scale if scale > 0.0 else 1.0):
             return KERNEL_SOLVED, pivots, residual
         if attempt == 0:
             first_status = KERNEL_RAY if status == RAY else KERNEL_NO_CONVERGENCE
-    p[:] = 0.0
-    u[:] = q
+    for i in range(q.shape[0]):
+        p[i], u[i] = 0.0, q[i]
     return first_status, pivots, residual
 
 
@@ -109,7 +107,7 @@ def solve_lemke(W, q, lo, hi, p, u, rtol, max_iter):
     return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
-@jit
+@jit_borrowing
 def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     """solve_lemke in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0]
     contacts): what the Moreau–Jean loop calls, allocating nothing per step."""

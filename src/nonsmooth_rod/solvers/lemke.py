@@ -51,7 +51,7 @@ import time
 import numpy as np
 
 from .._jit import ENABLED as HAVE_NUMBA
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
 from .kernel_base import carve, carve_matrix, solver_scratch, step_residual
@@ -369,19 +369,22 @@ def _scaled_step(W, q, d, Ws, qs):
 
 @jit
 def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
-    """_lemke_friction_into with scratch of its own: (p, u, residual, status, pivots, norms)."""
+    """_lemke_friction_into with scratch and p, u of its own: (p, u, residual, status, pivots, norms)."""
     floats, ints = solver_scratch(len(lo))
-    return _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints)
+    p, u = np.empty(2 * len(lo)), np.empty(2 * len(lo))
+    residual, status, pivots, q_norm, W_norm, scale = _lemke_friction_into(W, q, lo, hi, max_pivots, formulation,
+                                                                          floats, ints, p, u)
+    return p, u, residual, status, pivots, (q_norm, W_norm, scale)
 
 
-@jit
-def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints):
-    """Friction step → lifted LCP → Lemke → (p, u, residual, status, pivots, norms), every
-    array carved from the scratch (floats, ints: kernel_base.solver_scratch of ≥ len(lo)
-    contacts; p and u are views of it).
-
-    norms = (‖q‖∞, max|W|, max(‖p‖∞, ‖u‖∞, ‖q‖∞)) for the acceptance test and the contact
-    states (computed here, they cost nothing; in Python after the call, microseconds).
+@jit_borrowing
+def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p, u):
+    """Friction step → lifted LCP → Lemke → p, u (2 len(lo) each, written) and (residual,
+    status, pivots, ‖q‖∞, max|W|, max(‖p‖∞, ‖u‖∞, ‖q‖∞)) — the norms for the acceptance test
+    and the contact states (computed here, they cost nothing; in Python after the call,
+    microseconds). Every temporary is carved from the scratch (floats, ints:
+    kernel_base.solver_scratch of ≥ len(lo) contacts). Compiled without reference counting
+    (the step's hot path): it allocates nothing and returns no array.
 
     ``formulation``: INTERVAL (3 unknowns per contact) or CONE (4 per contact). The LCP is
     built from D W D and D q, D = diag(d_c) per contact (both rows of a contact alike, which
@@ -401,20 +404,20 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints):
     T, at = carve_matrix(floats, at, n, 2 * n + 2)
     z, at = carve(floats, at, n)
     refine, at = carve(floats, at, n)
-    p, at = carve(floats, at, 2 * n_c)
-    u, at = carve(floats, at, 2 * n_c)
     _contact_scales(W, n_c, d)
     W_norm, q_norm, w_scale, q_scale = _scaled_step(W, q, d, Ws, qs)
-    M[:, :] = 0.0
-    qq[:] = 0.0
+    for i in range(n):
+        qq[i] = 0.0
+        for j in range(n):
+            M[i, j] = 0.0
     if formulation == INTERVAL:
         _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
         _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     status, pivots, entering = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)
 
-    p[:] = 0.0
-    u[:] = 0.0
+    for i in range(2 * n_c):
+        p[i], u[i] = 0.0, 0.0
     residual = 0.0
     if status == SOLVED or status == RAY:
         for j in range(n_c):
@@ -426,15 +429,14 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints):
             else:
                 p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
         residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
-    norms = (q_norm, W_norm, max(q_norm, _max_abs(p), _max_abs(u)))
+    scale = max(q_norm, _max_abs(p), _max_abs(u))
     if status == RAY:
         # Wedged contacts (two normals nearly opposed, W singular) make the solution set
         # unbounded, and Lemke may leave on a ray with z0 ~ 1e-11 instead of 0: the point it
         # stops at then already solves the step to round-off, and is accepted as such.
-        scale = norms[2] if norms[2] > 0.0 else 1.0
-        if residual <= RESIDUAL_TOL * scale:
+        if residual <= RESIDUAL_TOL * (scale if scale > 0.0 else 1.0):
             status = SOLVED
-    return p, u, residual, status, pivots, norms
+    return residual, status, pivots, q_norm, W_norm, scale
 
 
 @jit

@@ -25,7 +25,7 @@ import numpy as np
 
 from .. import solvers as _solvers
 from .. import _jit
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 # The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
 # Python (solve_two_coefficient below).
 from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS,
@@ -247,7 +247,7 @@ def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_
                                 rtol, max_iter, p, u, states, floats, ints)
 
 
-@jit
+@jit_borrowing
 def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting, rtol,
                          max_iter, p, u, states, floats, ints):
     """The exact two-coefficient law on u = W p + q, from slip guess `guess` (updated in place to
@@ -256,15 +256,16 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
     (per contact): the gap-closing part g/h of q_N, which a held body may leave open; `resting`:
     1 for a contact whose slip velocity at the step's start is round-off. Once the
     sign iteration is consistent, a contact that started at rest slides only if no admissible
-    impulse split holds it (hold_at_rest). floats, ints: scratch (kernel_base.solver_scratch;
-    one of its own when they are too small for these contacts).
-    Returns (kernel status, solves, solver iterations, consistent, pgs steps solved again by Lemke)."""
+    impulse split holds it (hold_at_rest). floats, ints: scratch (kernel_base.solver_scratch
+    for at least these contacts: the caller's fitting_scratch).
+    Returns (kernel status, solves, solver iterations, consistent, pgs steps solved again by Lemke).
+    Compiled without reference counting (the step's hot path): it allocates nothing."""
     na = guess.shape[0]
-    floats, ints = fitting_scratch(floats, ints, na)
     start_guess, at = carve(floats, 0, na)
     p_start, at = carve(floats, at, 2 * na)  # the warm start, the previous step's split
-    start_guess[:] = guess
-    p_start[:] = p
+    for j in range(na):
+        start_guess[j] = guess[j]
+        p_start[2 * j], p_start[2 * j + 1] = p[2 * j], p[2 * j + 1]
     lo, at = carve(floats, at, na)
     hi, at = carve(floats, at, na)
     new_guess, at = carve(floats, at, na)
@@ -276,7 +277,8 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
     velocity_tol = 1e-9 * scale_v
     n_tried, iterations, fallbacks, consistent, last = 0, 0, 0, False, False
     while True:
-        tried[n_tried] = guess
+        for j in range(na):
+            tried[n_tried, j] = guess[j]
         n_tried += 1
         _interval_of(mu_s, mu_d, guess, lo, hi)
         status, its, residual, fell_back = _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol,
@@ -291,7 +293,8 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
         if last:  # the ordinary μs problem after a cycle: exact for sticking, counted inconsistent
             break
         action = next_action(new_guess, tried, n_tried)
-        guess[:] = new_guess
+        for j in range(na):
+            guess[j] = new_guess[j]
         if action == NEXT_STOP:
             break
         last = action == NEXT_TRY_ZERO
@@ -319,6 +322,7 @@ def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, rest
     as two_coefficient_kernel (solves, iterations and fallbacks summed; consistent when every
     group is)."""
     na = mu_s.shape[0]
+    floats, ints = fitting_scratch(floats, ints, na)  # (the groups are smaller: it fits them too)
     empty, no_blocks = ints[:0], floats[:0].reshape((0, 2, 2))  # no sparse W (views: nothing allocated)
     if na <= GROUP_MIN_CONTACTS:
         return two_coefficient_into(solver_code, W, empty, empty, no_blocks, q, mu_s, mu_d, guess, closing, resting,
@@ -372,7 +376,8 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     velocity_tol = 1e-9 * max(1e-12, float(np.max(np.abs(q), initial=0.0)))
     n_tried, iterations, consistent, last = 0, 0, False, False
     while True:
-        tried[n_tried] = guess
+        for j in range(na):
+            tried[n_tried, j] = guess[j]
         n_tried += 1
         interpreted(_interval_of)(mu_s, mu_d, guess, lo, hi)
         sol = _solvers.solve(PlanarFrictionProblem(W, q, lo, hi), solver, **(solver_options or {}))
