@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit, jit_inline
+from .._jit import jit, jit_borrowing, jit_inline
 
 # Status codes.
 KERNEL_SOLVED = 0
@@ -37,7 +37,7 @@ def all_finite(values) -> bool:
     return True
 
 
-@jit
+@jit_borrowing
 def step_residual(W, q, lo, hi, p, u):
     """u = W p + q in place; return the complementarity residual (problem.py's formula)."""
     m = q.shape[0]
@@ -49,7 +49,7 @@ def step_residual(W, q, lo, hi, p, u):
     return contact_residual(lo, hi, p, u)
 
 
-@jit
+@jit_borrowing
 def contact_residual(lo, hi, p, u):
     """max over contacts of |min(p_N, u_N)| and |p_T − proj_[lo p_N⁺, hi p_N⁺](p_T − u_T)|."""
     residual = 0.0
@@ -66,7 +66,7 @@ def contact_residual(lo, hi, p, u):
     return residual
 
 
-@jit
+@jit_borrowing
 def problem_scale(q, p, u) -> float:
     """max(‖q‖∞, ‖p‖∞, ‖u‖∞), or 1 when all vanish: what a relative tolerance multiplies."""
     scale = 0.0

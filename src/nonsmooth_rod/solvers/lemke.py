@@ -87,7 +87,10 @@ TIE_TOL = 1e-14
 RESIDUAL_TOL = 1e-9
 
 
-@jit
+# The pivoting and its helpers are compiled without reference counting (_jit.jit_borrowing): they
+# take arrays and return numbers, so any caller may call them, and the row views they take in
+# their loops (a pivot touches every row) count nothing.
+@jit_borrowing
 def _fill_tableau(T, M, q, n):
     """T = [I | −M | −d | q] with covering vector d = (1, …, 1); T must be zero on entry."""
     for i in range(n):
@@ -100,7 +103,7 @@ def _fill_tableau(T, M, q, n):
         row[2 * n + 1] = q[i]
 
 
-@jit
+@jit_borrowing
 def _pivot(T, r, e):
     """Gauss–Jordan pivot of tableau T on row r, column e, in place."""
     n_cols = T.shape[1]
@@ -119,7 +122,7 @@ def _pivot(T, r, e):
                 other[e] = 0.0
 
 
-@jit
+@jit_borrowing
 def _lex_smaller(T, i, k, e, n):
     """Is row i's (rhs, B⁻¹ row)/T[i, e] lexicographically smaller than row k's?
 
@@ -147,7 +150,7 @@ def _lex_smaller(T, i, k, e, n):
     return False
 
 
-@jit
+@jit_borrowing
 def _first_leaving_row(T, n, rhs):
     """Entering z0 drives w up by z0·d; the row that leaves is the lexicographic minimum of
     (q_i, e_i): the most negative q_i, ties to the LARGEST index (e_i is lexicographically
@@ -163,7 +166,7 @@ def _first_leaving_row(T, n, rhs):
     return r
 
 
-@jit
+@jit_borrowing
 def _prefer_z0(T, r, z0_row, entering, rhs, pivot_tol):
     """If z0 ties for leaving, let it leave: that ends the method with a solution."""
     a0 = T[z0_row, entering]
@@ -175,7 +178,7 @@ def _prefer_z0(T, r, z0_row, entering, rhs, pivot_tol):
     return r
 
 
-@jit
+@jit_borrowing
 def _complementary_pivoting(T, basis, n, max_pivots):
     """Lemke's method on tableau T = [I | −M | −d | q]; basis[i] is the variable of row i.
 
@@ -197,7 +200,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
     return _resume_pivoting(T, basis, n, leaving + n, 1, max_pivots)
 
 
-@jit
+@jit_borrowing
 def _resume_pivoting(T, basis, n, entering, pivots, max_pivots):
     """The pivoting loop from `entering` (the complement of the variable that left last), after
     `pivots` pivots, up to max_pivots in all: (status, pivots, entering)."""
@@ -235,7 +238,7 @@ def _resume_pivoting(T, basis, n, entering, pivots, max_pivots):
         entering = leaving + n if leaving < n else leaving - n
 
 
-@jit
+@jit_borrowing
 def _basic_solution(T, basis, M, q, n, z, residual):
     """z from the final basis, with one step of iterative refinement against the original M, q
     (`residual`: n floats of scratch).
@@ -271,23 +274,26 @@ def _basic_solution(T, basis, M, q, n, z, residual):
             z[v - n] = max(x, 0.0)
 
 
-@jit
+@jit_borrowing
 def _lemke_kernel(M, q, max_pivots, T, basis, z, residual):
     """Lemke on (M, q) given as rows/vector, in the caller's scratch (T: n × (2n + 2), basis,
     z, residual: n); fills z, returns (status, pivots, last entering)."""
     n = len(q)
-    T[:, :] = 0.0
+    for i in range(n):
+        for j in range(T.shape[1]):
+            T[i, j] = 0.0
     _fill_tableau(T, M, q, n)
     for i in range(n):
         basis[i] = i
     status, pivots, entering = _complementary_pivoting(T, basis, n, max_pivots)
-    z[:] = 0.0
+    for j in range(n):
+        z[j] = 0.0
     if status == SOLVED or status == RAY:  # at a ray z is the last point of the path
         _basic_solution(T, basis, M, q, n, z, residual)
     return status, pivots, entering
 
 
-@jit
+@jit_borrowing
 def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
     """The 3-per-contact LCP of the module docstring, from W / w_scale and q / q_scale."""
     n_c = len(lo)
@@ -308,7 +314,7 @@ def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
         qq[3 * i + 1] = q[2 * i + 1] / q_scale
 
 
-@jit
+@jit_borrowing
 def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
     """The 4-per-contact (Anitescu–Potra) LCP of the module docstring, scaled likewise."""
     n_c = len(lo)
@@ -342,7 +348,7 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
         qq[4 * i + 2] = lo[i] * q[2 * i + 1] / q_scale
 
 
-@jit
+@jit_borrowing
 def _contact_scales(W, n_c, d):
     """d: per contact the power of two nearest 1/√max(W_NN, W_TT) (1 for a zero block)."""
     for c in range(n_c):
@@ -352,7 +358,7 @@ def _contact_scales(W, n_c, d):
             d[c] = 2.0 ** (-np.round(0.5 * np.log2(diagonal)))
 
 
-@jit
+@jit_borrowing
 def _scaled_step(W, q, d, Ws, qs):
     """Ws = D W D, qs = D q; returns (max|W|, max|q|, max|Ws| or 1, max|qs| or 1)."""
     W_norm, q_norm, ws_norm, qs_norm = 0.0, 0.0, 0.0, 0.0
@@ -439,7 +445,7 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     return residual, status, pivots, q_norm, W_norm, scale
 
 
-@jit
+@jit_borrowing
 def _max_abs(values):
     largest = 0.0
     for value in values:

@@ -56,7 +56,7 @@ class StepContactResult:
     consistent: bool
 
 
-@jit
+@jit_borrowing
 def classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
     """States of a step solution under slip guess `guess`; True when the guess is consistent.
 
@@ -98,7 +98,7 @@ def classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_gue
     return consistent
 
 
-@jit
+@jit_borrowing
 def _seen(tried, n_tried, guess):
     for k in range(n_tried):
         same = True
@@ -110,7 +110,7 @@ def _seen(tried, n_tried, guess):
     return False
 
 
-@jit
+@jit_borrowing
 def next_action(new_guess, tried, n_tried):
     """After an inconsistent solve: retry with new_guess, or — cycling between guesses (possible
     only with several interacting contacts) or out of solves — solve the ordinary μs problem
@@ -122,7 +122,7 @@ def next_action(new_guess, tried, n_tried):
     return NEXT_STOP if _seen(tried, n_tried, new_guess) else NEXT_TRY_ZERO
 
 
-@jit
+@jit_borrowing
 def _interval_of(mu_s, mu_d, guess, lo, hi):
     """The friction interval [c − μs, c + μs], c = (μs − μd) s, of slip guess s."""
     for j in range(guess.shape[0]):
