@@ -34,8 +34,9 @@ from ..solvers import available_solvers, check_solver_options
 from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
-from ..validation import Choice, Flag, InputError, Number, Text, check_options, option, require_positive, require_state
+from ..validation import Choice, Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
+from .declaration import Declaration, Refusal, first_driven, first_joint
 from .joint_step import work_size
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
@@ -146,12 +147,16 @@ def _chunk_size(grid: Grid, stopping: bool) -> int:
     return max(1, min(MAX_CHUNK, grid.n_steps))
 
 
-def _check_resume(resume, n_dof: int, nc: int) -> None:
+def check_resume(resume, scene, q0, v0) -> None:
+    """Refuse an end state that is not a Moreau–Jean one of this scene, ending in (q0, v0)."""
+    n_dof, nc = scene.n_dof, len(scene.contacts)
     if not isinstance(resume, ResumeState):
         raise InputError(f"resume must be the end_state of a Moreau–Jean result, got {type(resume).__name__}")
     if resume.q.shape[1:] != (n_dof,) or resume.states.shape[1:] != (nc,) or resume.q.shape[0] != \
             resume.states.shape[0] + 1 or resume.states.shape[0] > HISTORY:
         raise InputError("resume state does not match the scene (degrees of freedom or contacts)")
+    if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
+        raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
 
 
 # Steps run interpreted to measure a cold run's per-step cost before deciding whether to compile.
@@ -239,14 +244,10 @@ class MoreauJean:
         """From (q0, v0) at t0 (or the end state `resume` of an earlier run) to exactly t_end,
         keeping one sample per `save_every` (default: every step); `stop`: callables (t, q, v)
         tried at each kept sample, ending the run at the first that holds."""
-        if not t_end > t0:
-            raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
         opts, names = self.options, [c.name for c in scene.contacts]
-        q0, v0 = require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
-        if resume is not None:
-            _check_resume(resume, scene.n_dof, len(names))
-            if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
-                raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
+        q0, v0 = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)  # checked by the driver
+        if opts.fast:  # a run that would be compiled: say once if numba is missing
+            _jit.warn_once_without_numba()
         if opts.tol is not None:
             return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop, names)
         grid = Grid.of(opts.h, t0, t_end, resume)
@@ -274,10 +275,6 @@ class MoreauJean:
         """The error-controlled run (integrators/adaptive.py) on this integrator's loop and kernels."""
         from .adaptive import run_adaptive
 
-        if scene.joints or scene.driven_things():
-            what = f"joint {scene.joints[0].name!r}" if scene.joints else scene.driven_things()[0] + " (driven)"
-            raise InputError(f"tol: error control does not handle joints or driven obstacles and bodies yet ({what}); "
-                             "give a fixed step h instead")
         packed = pack_scene(scene)
         model, work = _model_and_work(packed, resume)
         params, iparams = self._parameters(scene, Grid.of(self.options.h, t0, t_end, None), names)
@@ -506,6 +503,21 @@ class MoreauJean:
         result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
         return result
 
+
+def _tol_with_joints_or_driven(scene, options, duration) -> dict | None:
+    if options.tol is None:
+        return None
+    found = first_joint(scene) or first_driven(scene)
+    return None if found is None else {"item": found["item"] + ("" if scene.joints else " (driven)")}
+
+
+MoreauJean.declares = Declaration(
+    options=MoreauJeanOptions,
+    contacts=("DiskOnLine", "DiskOnDisk", "DiskOnSegment", "SegmentEndOnEdge", "VertexOnEdge"),
+    samples_estimate=MoreauJean.samples_estimate, samples_knob=MoreauJean.SAMPLES_KNOB,
+    refusals=(Refusal(_tol_with_joints_or_driven, "tol: error control does not handle joints or driven obstacles "
+                                                  "and bodies yet ({item}); give a fixed step h instead"),),
+    absolute_time=True, resumes=check_resume)
 
 def joint_forces(joints, impulses_over_h) -> dict:
     """{joint name: {reaction: samples}}: a pin's world force (Fx, Fy) on body_a, a slider's force
