@@ -9,14 +9,15 @@ trust their inputs; it never asks which method it runs.
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
+import math
 import re
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
+from . import _jit
 from .integrators import METHODS, MAX_OUTPUT_BYTES, check_output_size, integrator_class
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
@@ -81,6 +82,8 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     opts = _options(declared.options, method, options, impact_stops)
     _check_refusals(method, declared, scene, opts, t_end - t0)
     check_output_size(declared.samples_estimate(opts, t_end - t0, save_every), scene, declared.samples_knob)
+    if declared.compiles is not None and declared.compiles(opts):  # say once if numba is missing
+        _jit.warn_once_without_numba()
     if resume is not None:
         if declared.resumes is None:
             raise InputError(f"resume: only a Moreau–Jean run continues from an end state; method "
@@ -161,6 +164,9 @@ _CHECKED_OPTIONS: dict = {}
 MAX_CHECKED_OPTIONS = 256
 
 
+_PLAIN = (str, bool, int, type(None))  # option values that are their own key (with their type)
+
+
 def _frozen(value):
     """A hashable key of an option's value and its type (dicts and lists by their items)."""
     if isinstance(value, dict):
@@ -172,10 +178,26 @@ def _frozen(value):
     return type(value), value
 
 
+def _options_key(options: dict) -> tuple:
+    """_frozen(options) without the recursion for the common case of plain values (a float by
+    its bits: -0.0 is not 0.0, and NaN never matches, so it is checked, and refused, every time)."""
+    items = []
+    for k, v in options.items():
+        kind = type(v)
+        if kind is float:
+            items.append((k, kind, v, math.copysign(1.0, v)))
+        elif kind in _PLAIN:
+            items.append((k, kind, v))
+        else:
+            items.append((k, _frozen(v)))
+    return tuple(items)
+
+
 def _options(options_cls, method: str, options: dict, impact_stops: list):
-    """The method's options object: checked on first use, a copy of the checked one after."""
+    """The method's options object: checked on first use, the checked one after (kept by the
+    values it was built from; no run changes its options)."""
     try:
-        key = (options_cls, _frozen(options), tuple(impact_stops))
+        key = (options_cls, _options_key(options), tuple(impact_stops))
         checked = _CHECKED_OPTIONS.get(key)
     except TypeError:  # an unhashable value (an array): checked every time
         key, checked = None, None
@@ -185,7 +207,7 @@ def _options(options_cls, method: str, options: dict, impact_stops: list):
             if len(_CHECKED_OPTIONS) >= MAX_CHECKED_OPTIONS:
                 _CHECKED_OPTIONS.clear()
             _CHECKED_OPTIONS[key] = checked
-    return copy.copy(checked)  # the run's own: nothing a run does reaches the cached one
+    return checked
 
 
 def _checked_options(options_cls, method: str, options: dict, impact_stops: list):

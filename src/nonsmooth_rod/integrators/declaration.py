@@ -37,7 +37,9 @@ class Declaration:
     holds while it runs (the driver's memory check); samples_knob: what keeps fewer;
     absolute_time: its `run` takes `t0`, `resume`, `save_every` and `stop` and keeps the scene's
     clock (otherwise the driver runs it from 0 on a shifted scene and thins and stops after);
-    resumes: how it checks an `end_state` to continue from (None: it restarts from (q, v) alone).
+    resumes: how it checks an `end_state` to continue from (None: it restarts from (q, v) alone);
+    compiles(options): True when a run with these options would run numba-compiled code (the
+    driver then says once if numba is missing; None: never).
     """
 
     options: type
@@ -47,6 +49,7 @@ class Declaration:
     refusals: tuple = ()
     absolute_time: bool = False
     resumes: Callable | None = None
+    compiles: Callable | None = None
 
 
 def first_joint(scene, options=None, duration=None) -> dict | None:

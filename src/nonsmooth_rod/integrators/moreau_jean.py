@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
-from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
+from ..model.motion import N_NOW_COLUMNS, Prescribed, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
@@ -46,6 +46,7 @@ from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING,
 # 65 536-step windows, save_every = 0.1 s: 8.1 MB measured for 1e6 and 1e7 steps).
 WINDOW_SAMPLES = 1.1
 STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
+_STATE_WORDS = np.array(STATE_NAMES, dtype=object)  # a state code's word (the result's modes)
 # Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
 # 0 means the kernel's own default (solvers/kernels.py).
 DEFAULT_RTOL, DEFAULT_MAX_ITER = 0.0, 0
@@ -173,9 +174,10 @@ def compiled_part(solver: str, solver_code, callback: bool):
     return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []  # callbacks run it step by step
 
 
-def _calls_back(scene) -> bool:
-    """True when a step needs Python: a Python applied_force or a Python (Prescribed) motion."""
-    return scene.applied_force is not None or scene.python_motions()
+def _python_motions(packed) -> list:
+    """The packed motions when one of them is a Python (Prescribed) one (each step evaluates
+    them from Python), else []."""
+    return packed.motions if any(isinstance(m, Prescribed) for m in packed.motions) else []
 
 
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
@@ -246,8 +248,6 @@ class MoreauJean:
         tried at each kept sample, ending the run at the first that holds."""
         opts, names = self.options, [c.name for c in scene.contacts]
         q0, v0 = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)  # checked by the driver
-        if opts.fast:  # a run that would be compiled: say once if numba is missing
-            _jit.warn_once_without_numba()
         if opts.tol is not None:
             return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop, names)
         grid = Grid.of(opts.h, t0, t_end, resume)
@@ -259,16 +259,18 @@ class MoreauJean:
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         params, iparams = self._parameters(scene, grid, names)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
-        engine = Engine(bool(opts.fast and _jit.ENABLED),
-                        *compiled_part(opts.solver, solver_code, _calls_back(scene)))
-        self._solver_error, self._packed = None, packed
+        # a step needs Python: a Python applied_force or a Python (Prescribed) motion
+        self._motions_in_python = _python_motions(packed)
+        self._calls_back = scene.applied_force is not None or bool(self._motions_in_python)
+        engine = Engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
+        self._solver_error = None
         wall = time.process_time()
         with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
             ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop))
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": engine.compiled and solver_code is not None,
-                 "force_callback": _calls_back(scene)}
+                 "force_callback": self._calls_back}
         return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
@@ -281,7 +283,7 @@ class MoreauJean:
         engine = Engine(bool(self.options.fast and _jit.ENABLED),
                         *compiled_part(self.options.solver, COMPILED_SOLVERS.get(self.options.solver),
                                        scene.applied_force is not None))
-        self._solver_error = None
+        self._solver_error, self._motions_in_python = None, []  # tol: no driven motions (declares)
         with _jit.one_blas_thread():
             return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
                                 model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
@@ -349,7 +351,7 @@ class MoreauJean:
         counters[loop.K_DONE] = r0
         kernels = engine.kernels
         with engine.compiling():
-            if not _calls_back(scene) and iparams[loop.I_SOLVER] >= 0:
+            if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
                 status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
             else:
                 status = self._run_stepwise(kernels, scene, r0, r0 + n, params, iparams, model, work, out)
@@ -374,7 +376,7 @@ class MoreauJean:
         q, v, counters = out[0], out[1], out[9]
         f, extra = np.empty(scene.n_dof), np.zeros(scene.n_dof)
         compiled = int(iparams[loop.I_SOLVER]) >= 0  # an exact solver: the compiled loop, one step a call
-        motions = self._packed.motions if scene.python_motions() else ()
+        motions = self._motions_in_python
         for k in range(r_start, r_end):
             if motions:
                 t = kernels.step_time(params, k)
@@ -473,7 +475,7 @@ class MoreauJean:
         impacts, events = self._impacts(scene, grid, collector, names)
         counters = window.out[9]
         t, q, v, a, N, T, codes = collector.trajectory_arrays()
-        modes = np.array(STATE_NAMES, dtype=object)[codes]
+        modes = _STATE_WORDS.take(codes)
         if k_end == grid.first and collector.resume is None:
             modes[:] = "open"
         t_stop = None
@@ -517,7 +519,7 @@ MoreauJean.declares = Declaration(
     samples_estimate=MoreauJean.samples_estimate, samples_knob=MoreauJean.SAMPLES_KNOB,
     refusals=(Refusal(_tol_with_joints_or_driven, "tol: error control does not handle joints or driven obstacles "
                                                   "and bodies yet ({item}); give a fixed step h instead"),),
-    absolute_time=True, resumes=check_resume)
+    absolute_time=True, resumes=check_resume, compiles=lambda options: options.fast)
 
 def joint_forces(joints, impulses_over_h) -> dict:
     """{joint name: {reaction: samples}}: a pin's world force (Fx, Fy) on body_a, a slider's force
