@@ -139,6 +139,8 @@ def _check_refusals(method: str, declared, scene: Scene, opts, duration: float) 
 
 def _stop_conditions(stop, scene: Scene):
     """Split stop conditions into impact names (the integrators stop themselves) and callables."""
+    if stop is None:
+        return [], []
     items = [] if stop is None else (list(stop) if isinstance(stop, (list, tuple)) else [stop])
     names = [c.name for c in scene.contacts]
     impacts, callables = [], []
