@@ -382,6 +382,9 @@ def start_compile_job(part: str, args: list[str]) -> bool:
     import subprocess
     import sys
 
+    started = _jobs.get(part)
+    if started is not None and started.poll() is None:
+        return False  # this process's job is still starting or compiling (before it takes the lock)
     with _part_lock(part, blocking=False) as lock:
         if not lock.acquired:
             return False  # some process is compiling it now
@@ -395,7 +398,13 @@ def start_compile_job(part: str, args: list[str]) -> bool:
         _marker(part).with_suffix(".pid").write_text(f"{job.pid}\n")
     except OSError:
         return False
+    _jobs[part] = job
     return True
+
+
+# The compile job this process started, by part: a run's next calls do not start another while it
+# runs (it takes the part's lock only once it has imported: ~1 s in which the lock is free).
+_jobs: dict = {}
 
 
 def compile_in_background(part: str, args: list[str], what: str, seconds: float) -> bool:

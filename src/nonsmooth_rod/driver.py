@@ -3,28 +3,25 @@
 In the spirit of scipy's `solve_ivp` and diffrax's `diffeqsolve`: one call, the method picked
 by name, its options passed through by keyword, one result type whatever the method. The
 driver validates everything once (the state, the times, the options, whether the method
-handles the scene's contacts, whether the output fits in memory), so the integrators — and
-the compiled loop — can trust their inputs.
+handles the scene, whether the output fits in memory) from what each integrator declares
+(its `declares`, integrators/declaration.py), so the integrators — and the compiled loop — can
+trust their inputs; it never asks which method it runs.
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 import re
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from . import _jit
-from .integrators import (HANDLES_JOINTS, METHODS, MAX_OUTPUT_BYTES, check_driven, check_output_size,
-                          integrator_classes, supported_contacts)
+from .integrators import METHODS, MAX_OUTPUT_BYTES, check_output_size, integrator_class
 from .model.scene import Scene
 from .results import Event, SimulationResult, Status, Trajectory
 from .validation import InputError, quoted, require_finite, require_positive, require_state
-
-# A max_step asking scipy for more steps than this is refused (about a minute of stepping).
-MAX_CAPPED_STEPS = 10**6
 
 
 @dataclass(frozen=True)
@@ -34,15 +31,19 @@ class StopAtImpact:
     contact: str
 
 
-@dataclass(frozen=True)
-class RunSetup:
-    """What a result was run with (`result.setup`): what `result.restart` runs again."""
+class RunSetup(NamedTuple):
+    """What a result was run with (`result.setup`), by the caller's names: what `result.restart`
+    runs again and what a saved result describes (result_files)."""
 
     scene: Scene
     method: str
     options: dict
     stop: object
     save_every: float | None
+    q0: np.ndarray
+    v0: np.ndarray
+    t0: float
+    t_end: float
 
 
 def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *, t0: float = 0.0,
@@ -50,8 +51,9 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     """Simulate `scene` from (q0, v0) at time t0 to exactly t_end with the named method.
 
     method: "moreau-jean" (options h, theta, solver, solver_options, activation_gamma,
-    min_phase, fast), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...) or "regularized"
-    (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping, time_limit, ...).
+    min_phase, fast, tol), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...) or
+    "regularized" (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping,
+    time_limit, ...): each integrator's options dataclass (its `declares.options`).
     save_every: keep one sample per this many seconds (default: every step / output_dt);
     Moreau–Jean thins while it runs, so memory follows what is kept.
     stop: a contact name or `StopAtImpact(name)` (the run ends at that contact's first
@@ -73,31 +75,34 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
         raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
     if save_every is not None:
         save_every = require_positive("save_every", save_every)
-    integrator_cls, options_cls = _method(method, scene)
+    integrator_cls = _integrator_class(method)
+    declared = integrator_cls.declares
+    _check_contacts(method, declared, scene)
     impact_stops, callables = _stop_conditions(stop, scene)
-    opts = _options(options_cls, method, options, impact_stops)
-    _check_step_cap(opts, t_end - t0)
-    check_output_size(integrator_cls.samples_estimate(opts, t_end - t0, save_every), scene,
-                      integrator_cls.SAMPLES_KNOB)
-    if getattr(opts, "fast", False):  # a run that would be compiled: say once if numba is missing
+    opts = _options(declared.options, method, options, impact_stops)
+    _check_refusals(method, declared, scene, opts, t_end - t0)
+    check_output_size(declared.samples_estimate(opts, t_end - t0, save_every), scene, declared.samples_knob)
+    if declared.compiles is not None and declared.compiles(opts):  # say once if numba is missing
         _jit.warn_once_without_numba()
-    result = _run(integrator_cls(opts), scene, q0, v0, t0, t_end, save_every, callables, resume)
+    if resume is not None:
+        if declared.resumes is None:
+            raise InputError(f"resume: only a Moreau–Jean run continues from an end state; method "
+                             f"{method!r} restarts from (q0, v0)")
+        declared.resumes(resume, scene, q0, v0)
+    result = _run(integrator_cls(opts), declared.absolute_time, scene, q0, v0, t0, t_end, save_every, callables,
+                  resume)
     result.method = method
-    result.setup = RunSetup(scene, method, dict(options), stop, save_every)
-    # What the run was asked for, by the caller's names: saved results describe it (result_files).
-    result.run_inputs = {"scene": scene, "q0": q0, "v0": v0, "t0": t0, "t_end": t_end,
-                         "options": dict(options), "save_every": save_every, "stop": stop}
+    result.setup = RunSetup(scene, method, dict(options), stop, save_every, q0, v0, t0, t_end)
     return result
 
 
-def _run(integrator, scene, q0, v0, t0, t_end, save_every, callables, resume) -> SimulationResult:
+def _run(integrator, absolute_time: bool, scene, q0, v0, t0, t_end, save_every, callables,
+         resume) -> SimulationResult:
     """The integrator's run: on the scene's own clock with the stops and thinning inside the run
-    where it can (Moreau–Jean); otherwise from 0 on a shifted scene, stops and thinning after."""
-    if getattr(integrator, "absolute_time", False):
+    where it declares so (`absolute_time`); otherwise from 0 on a shifted scene, stops and
+    thinning after."""
+    if absolute_time:
         return integrator.run(scene, q0, v0, t_end, t0=t0, resume=resume, save_every=save_every, stop=callables)
-    if resume is not None:
-        raise InputError(f"resume: only a Moreau–Jean run continues from an end state; method "
-                         f"{integrator.name!r} restarts from (q0, v0)")
     result = integrator.run(_shifted(scene, t0), q0, v0, t_end - t0)
     if t0:
         _shift_times(result, t0)
@@ -109,23 +114,33 @@ def _run(integrator, scene, q0, v0, t0, t_end, save_every, callables, resume) ->
     return result
 
 
-def _method(method, scene: Scene):
+def _integrator_class(method):
     if not isinstance(method, str) or method not in METHODS:
         raise InputError(f"unknown method {quoted(method)}; choose from: {', '.join(METHODS)}")
-    handled = supported_contacts(method)
+    return integrator_class(method)
+
+
+def _check_contacts(method: str, declared, scene: Scene) -> None:
+    """Refuse, by name, a contact relation the method does not run."""
+    handled = declared.contacts
     for contact in scene.contacts:
         if type(contact).__name__ not in handled:
             raise InputError(f"method {method!r} does not handle {type(contact).__name__} contacts "
                              f"(contact {contact.name!r}); it handles {', '.join(handled)}")
-    check_driven(method, scene)
-    if getattr(scene, "joints", ()) and method not in HANDLES_JOINTS:
-        raise InputError(f"method {method!r} does not handle joints (joint {scene.joints[0].name!r}); "
-                         f"use {' or '.join(HANDLES_JOINTS)}")
-    return integrator_classes(method)
+
+
+def _check_refusals(method: str, declared, scene: Scene, opts, duration: float) -> None:
+    """The method's declared refusals (joints, driven motions, settings), the first that applies."""
+    for refusal in declared.refusals:
+        message = refusal.check(method, scene, opts, duration)
+        if message is not None:
+            raise InputError(message)
 
 
 def _stop_conditions(stop, scene: Scene):
     """Split stop conditions into impact names (the integrators stop themselves) and callables."""
+    if stop is None:
+        return [], []
     items = [] if stop is None else (list(stop) if isinstance(stop, (list, tuple)) else [stop])
     names = [c.name for c in scene.contacts]
     impacts, callables = [], []
@@ -151,6 +166,9 @@ _CHECKED_OPTIONS: dict = {}
 MAX_CHECKED_OPTIONS = 256
 
 
+_PLAIN = (str, bool, int, type(None))  # option values that are their own key (with their type)
+
+
 def _frozen(value):
     """A hashable key of an option's value and its type (dicts and lists by their items)."""
     if isinstance(value, dict):
@@ -162,10 +180,26 @@ def _frozen(value):
     return type(value), value
 
 
+def _options_key(options: dict) -> tuple:
+    """_frozen(options) without the recursion for the common case of plain values (a float by
+    its bits: -0.0 is not 0.0, and NaN never matches, so it is checked, and refused, every time)."""
+    items = []
+    for k, v in options.items():
+        kind = type(v)
+        if kind is float:
+            items.append((k, kind, v, math.copysign(1.0, v)))
+        elif kind in _PLAIN:
+            items.append((k, kind, v))
+        else:
+            items.append((k, _frozen(v)))
+    return tuple(items)
+
+
 def _options(options_cls, method: str, options: dict, impact_stops: list):
-    """The method's options object: checked on first use, a copy of the checked one after."""
+    """The method's options object: checked on first use, the checked one after (kept by the
+    values it was built from; no run changes its options)."""
     try:
-        key = (options_cls, _frozen(options), tuple(impact_stops))
+        key = (options_cls, _options_key(options), tuple(impact_stops))
         checked = _CHECKED_OPTIONS.get(key)
     except TypeError:  # an unhashable value (an array): checked every time
         key, checked = None, None
@@ -175,7 +209,7 @@ def _options(options_cls, method: str, options: dict, impact_stops: list):
             if len(_CHECKED_OPTIONS) >= MAX_CHECKED_OPTIONS:
                 _CHECKED_OPTIONS.clear()
             _CHECKED_OPTIONS[key] = checked
-    return copy.copy(checked)  # the run's own: nothing a run does reaches the cached one
+    return checked
 
 
 def _checked_options(options_cls, method: str, options: dict, impact_stops: list):
@@ -191,15 +225,6 @@ def _checked_options(options_cls, method: str, options: dict, impact_stops: list
         raise
     except (TypeError, ValueError) as err:
         raise InputError(f"invalid option for method {method!r}: {err}") from None
-
-
-def _check_step_cap(opts, duration: float) -> None:
-    """Refuse a step cap (`max_step` of the ODE methods) that makes the run a hang: more than
-    MAX_CAPPED_STEPS steps of scipy's integrators (each tens of microseconds)."""
-    cap = getattr(opts, "max_step", math.inf)
-    if duration / cap > MAX_CAPPED_STEPS:
-        raise InputError(f"max_step = {cap:g} s over a run of {duration:g} s asks for more than "
-                         f"{MAX_CAPPED_STEPS:.0e} ODE steps: use max_step ≥ {duration / MAX_CAPPED_STEPS:.3g} s")
 
 
 def _shifted(scene: Scene, t0: float) -> Scene:

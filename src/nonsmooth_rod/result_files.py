@@ -38,7 +38,8 @@ def body_names_of(result) -> list[str]:
     if sf is not None:
         return list(sf.body_names)
     n = result.trajectory.q.shape[1] // 3
-    scene = (getattr(result, "run_inputs", None) or {}).get("scene")
+    setup = getattr(result, "setup", None)
+    scene = setup.scene if setup is not None else None
     names = [str(b.name) for b in scene.bodies] if scene is not None and len(scene.bodies) == n else []
     # Names become column prefixes: they must be distinct and not clash with the fallback ones.
     if len(set(names)) == n and all(name and name.isprintable() and "." not in name for name in names):
@@ -176,14 +177,14 @@ def _force_data(force, bodies) -> dict:
 def scene_description(result) -> dict | None:
     """The scene and start of a run made through `nr.simulate` (no scene file), in the scene
     file's layout (docs/scene-format.md): bodies, lines, contacts, forces, initial state."""
-    inputs = getattr(result, "run_inputs", None)
-    if not inputs:
+    inputs = getattr(result, "setup", None)
+    if inputs is None:
         return None
-    scene, bodies = inputs["scene"], body_names_of(result)
+    scene, bodies = inputs.scene, body_names_of(result)
     lines: dict = {}
     segments: dict = {}
     contacts = [_contact_data(c, bodies, lines, segments) for c in scene.contacts]
-    q0, v0 = np.asarray(inputs["q0"], float), np.asarray(inputs["v0"], float)
+    q0, v0 = np.asarray(inputs.q0, float), np.asarray(inputs.v0, float)
     driven = {d.body: d.motion for d in getattr(scene, "driven", ())}
     return {
         "gravity": scene.gravity,
@@ -205,9 +206,10 @@ def _run_options(result) -> dict:
     sf = getattr(result, "scene_file", None)
     if sf is not None:
         return {**sf.options, "t_end": sf.t_end, "stop": sf.stop, "save_every": sf.save_every}
-    inputs = getattr(result, "run_inputs", None) or {}
-    keys = ("t0", "t_end", "save_every", "stop")
-    return {**_plain(inputs.get("options", {})), **{k: _plain(inputs[k]) for k in keys if k in inputs}}
+    setup = getattr(result, "setup", None)
+    if setup is None:
+        return {}
+    return {**_plain(setup.options), **{k: _plain(getattr(setup, k)) for k in ("t0", "t_end", "save_every", "stop")}}
 
 
 def summary_dict(result, command=None) -> dict:

@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import nonsmooth_rod as nr
+
 from nonsmooth_rod.integrators.event_driven import EventDriven, EventDrivenOptions
 from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import DiskOnLine, Line, PointOnLine
@@ -74,11 +76,11 @@ def test_under_an_applied_force_the_step_grows_instead_of_being_capped():
 def test_an_output_grid_too_fine_to_hold_is_refused_up_front():
     scene, q0 = block()
     with pytest.raises(InputError, match="output_dt"):
-        EventDriven(EventDrivenOptions(output_dt=1e-12)).run(scene, q0, np.zeros(3), 100.0)
+        nr.simulate(scene, q0, np.zeros(3), 100.0, method="event-driven", output_dt=1e-12)
     with pytest.raises(InputError, match="v0"):
-        EventDriven().run(scene, q0, [0.0, math.nan, 0.0], 1.0)
+        nr.simulate(scene, q0, [0.0, math.nan, 0.0], 1.0, method="event-driven")
     with pytest.raises(InputError, match="q0"):
-        EventDriven().run(scene, q0[:2], np.zeros(3), 1.0)
+        nr.simulate(scene, q0[:2], np.zeros(3), 1.0, method="event-driven")
 
 
 def test_the_resting_benchmark_runs_in_quick_mode(capsys):

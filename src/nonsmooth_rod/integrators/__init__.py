@@ -4,9 +4,10 @@
     event-driven   smooth modes joined by located events (disks and points on lines)
     regularized    smooth friction and penalty contact integrated by a scipy ODE solver
 
-An integrator is a class with `name`, an options dataclass, and
-`run(scene, q0, v0, t_end) -> SimulationResult`; the table below also declares which contact
-relations each handles, which the driver checks once before a run.
+An integrator is a class with `name`, `declares` (integrators/declaration.py: its options
+dataclass, the contact relations it runs, what else it refuses and why, how many samples a run
+keeps) and `run(scene, q0, v0, t_end) -> SimulationResult`. The driver checks a run once against
+the declaration, and the integrator trusts what it is given.
 """
 from __future__ import annotations
 
@@ -19,43 +20,33 @@ from ..validation import InputError
 # (bytes, check_output_size's estimate) is refused before it allocates anything.
 MAX_OUTPUT_BYTES = 4 * 2**30
 
-# method name → (module, integrator class, options class, contact relations it handles)
+# method name → (module, integrator class)
 METHODS = {
-    "moreau-jean": ("moreau_jean", "MoreauJean", "MoreauJeanOptions", ("DiskOnLine", "DiskOnDisk", "DiskOnSegment",
-                                                                             "SegmentEndOnEdge", "VertexOnEdge")),
-    "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine",)),
-    "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
+    "moreau-jean": ("moreau_jean", "MoreauJean"),
+    "event-driven": ("event_driven", "EventDriven"),
+    "regularized": ("regularized", "Regularized"),
 }
-
-# The methods that run driven obstacles and bodies (model/motion.py). The event-driven reference
-# would need each driven contact's gap, velocity and acceleration as functions of time in its
-# modes' ODEs and event functions, the regularized method the obstacle's velocity in its penalty
-# and friction laws: neither has them yet, and refuses such a scene by name.
-DRIVEN_METHODS = ("moreau-jean",)
+_CLASSES: dict = {}  # method name → its integrator class, imported once per process
 
 
-def check_driven(method: str, scene) -> None:
-    """Refuse, in one line, a driven obstacle or body for a method that does not move them."""
-    driven = scene.driven_things()
-    if driven and method not in DRIVEN_METHODS:
-        raise InputError(f"method {method!r} does not handle driven obstacles or bodies ({driven[0]} moves by a "
-                         f"prescribed motion): it lacks their time-dependent gap and velocity; use "
-                         f"{', '.join(DRIVEN_METHODS)}")
-# The methods that take bilateral joints (model/joints.py); the driver refuses a jointed scene for
-# the others, naming a joint.
-HANDLES_JOINTS = ("moreau-jean",)
-
-
-def supported_contacts(method: str) -> tuple[str, ...]:
-    """Names of the contact relation classes a method handles."""
-    return METHODS[method][3]
+def integrator_class(method: str):
+    """The integrator class of a method name (its module imported on first use); KeyError if unknown."""
+    cls = _CLASSES.get(method)
+    if cls is None:
+        module_name, cls_name = METHODS[method]
+        cls = _CLASSES[method] = getattr(importlib.import_module(f"{__name__}.{module_name}"), cls_name)
+    return cls
 
 
 def integrator_classes(method: str):
     """(integrator class, options class) of a method name; KeyError if unknown."""
-    module_name, cls_name, options_name, _ = METHODS[method]
-    module = importlib.import_module(f"{__name__}.{module_name}")
-    return getattr(module, cls_name), getattr(module, options_name)
+    cls = integrator_class(method)
+    return cls, cls.declares.options
+
+
+def supported_contacts(method: str) -> tuple[str, ...]:
+    """Names of the contact relation classes a method handles (its declaration's)."""
+    return integrator_class(method).declares.contacts
 
 
 def sample_bytes(n_dof: int, n_contacts: int) -> int:
@@ -66,8 +57,8 @@ def sample_bytes(n_dof: int, n_contacts: int) -> int:
 
 def check_output_size(samples: float, scene, knob: str = "save_every or a shorter t_end") -> float:
     """Refuse a run whose `samples` kept samples cannot fit the limit; returns the bytes they need.
-    Each integrator's `samples_estimate(options, duration, save_every)` says how many it keeps,
-    its `SAMPLES_KNOB` what lowers it."""
+    Each integrator's declaration says how many it keeps (`samples_estimate(options, duration,
+    save_every)`) and what lowers it (`samples_knob`)."""
     needed = samples * sample_bytes(scene.n_dof, len(scene.contacts))
     if not math.isfinite(needed) or needed > MAX_OUTPUT_BYTES:
         raise InputError(f"the run would keep {samples:.3g} samples ({needed / 2**30:.3g} GiB), over the "
@@ -75,6 +66,5 @@ def check_output_size(samples: float, scene, knob: str = "save_every or a shorte
     return needed
 
 
-__all__ = ["METHODS", "DRIVEN_METHODS", "check_driven", "HANDLES_JOINTS", "MAX_OUTPUT_BYTES", "check_output_size",
-           "integrator_classes", "sample_bytes",
-           "supported_contacts"]
+__all__ = ["METHODS", "MAX_OUTPUT_BYTES", "check_output_size", "integrator_class", "integrator_classes",
+           "sample_bytes", "supported_contacts"]

@@ -48,19 +48,9 @@ from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
-from ..validation import (
-    Choice,
-    InputError,
-    Integer,
-    Number,
-    Text,
-    check_options,
-    option,
-    require_positive,
-    require_state,
-)
+from ..validation import Choice, Integer, Number, Text, check_options, option
 from ..solvers import available_solvers
-from . import check_output_size
+from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
@@ -454,7 +444,8 @@ class EventDriven:
                     "the sliding problem has no solution here (Painlevé-type inconsistency)")
     # ------------------------------------------------------------------ main loop
     def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        q, v = self._check_inputs(scene, q0, v0, t_end)
+        """From (q0, v0) at 0 to t_end (inputs as the driver checked them: `declares`)."""
+        q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
         wall = time.process_time()
         names = [c.name for c in scene.contacts]
         run = _Run(0.0, q, v)
@@ -471,17 +462,6 @@ class EventDriven:
                 run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
             result = self._result(scene, run, names, status, message, time.process_time() - wall)
         return _finite_part(result)
-
-    def _check_inputs(self, scene, q0, v0, t_end):
-        require_positive("t_end", t_end)
-        for c in scene.contacts:
-            if not hasattr(c, "line"):
-                raise InputError("the event-driven integrator handles disk/point-on-line contacts only")
-            if not (isinstance(c.body, (int, np.integer)) and 0 <= c.body < len(scene.bodies)):
-                raise InputError(f"contact {c.name}: body must be an index below {len(scene.bodies)}, "
-                                 f"got {c.body!r}")
-        check_output_size(self.samples_estimate(self.options, t_end, None), scene, self.SAMPLES_KNOB)
-        return require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
 
     def _loop(self, scene, run, modes, t_end, names):
         """Segments and switches until t_end (or a stop); returns (status, message)."""
@@ -728,3 +708,8 @@ class EventDriven:
                     a[row + k], N[row + k], T[row + k] = d.a, d.normal_force, d.tangential_force
             row += len(bt)
         return Trajectory(ts, y[:, :n_dof], y[:, n_dof:], a, N, T, modes)
+
+
+EventDriven.declares = Declaration(
+    options=EventDrivenOptions, contacts=("DiskOnLine",), samples_estimate=EventDriven.samples_estimate,
+    samples_knob=EventDriven.SAMPLES_KNOB, refusals=(NO_JOINTS, NO_DRIVEN, STEP_CAP))

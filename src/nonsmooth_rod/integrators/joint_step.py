@@ -56,6 +56,8 @@ def pseudo_inverse(A, A_pinv):
 
 def work_size(table, n_dof: int) -> int:
     """Floats of the joints' work buffer (joint_views) for the joint table and n_dof."""
+    if not table.shape[0]:  # no joints (most scenes): no call of the compiled jointed_dofs
+        return 0
     rows, nd = ROWS_PER_JOINT * table.shape[0], jointed_dofs(table, n_dof)[0].shape[0]
     return rows * n_dof + rows + rows * rows + nd * nd + rows
 

@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
-from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
+from ..model.motion import N_NOW_COLUMNS, Prescribed, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
@@ -34,8 +34,9 @@ from ..solvers import available_solvers, check_solver_options
 from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
 from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
-from ..validation import Choice, Flag, InputError, Number, Text, check_options, option, require_positive, require_state
+from ..validation import Choice, Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
+from .declaration import Declaration, Refusal, first_driven, first_joint
 from .joint_step import work_size
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
@@ -45,6 +46,7 @@ from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING,
 # 65 536-step windows, save_every = 0.1 s: 8.1 MB measured for 1e6 and 1e7 steps).
 WINDOW_SAMPLES = 1.1
 STATE_CODES = {name: code for code, name in enumerate(STATE_NAMES)}
+_STATE_WORDS = np.array(STATE_NAMES, dtype=object)  # a state code's word (the result's modes)
 # Solver settings the compiled kernels take (the Python solvers read solver_options themselves);
 # 0 means the kernel's own default (solvers/kernels.py).
 DEFAULT_RTOL, DEFAULT_MAX_ITER = 0.0, 0
@@ -146,12 +148,16 @@ def _chunk_size(grid: Grid, stopping: bool) -> int:
     return max(1, min(MAX_CHUNK, grid.n_steps))
 
 
-def _check_resume(resume, n_dof: int, nc: int) -> None:
+def check_resume(resume, scene, q0, v0) -> None:
+    """Refuse an end state that is not a Moreau–Jean one of this scene, ending in (q0, v0)."""
+    n_dof, nc = scene.n_dof, len(scene.contacts)
     if not isinstance(resume, ResumeState):
         raise InputError(f"resume must be the end_state of a Moreau–Jean result, got {type(resume).__name__}")
     if resume.q.shape[1:] != (n_dof,) or resume.states.shape[1:] != (nc,) or resume.q.shape[0] != \
             resume.states.shape[0] + 1 or resume.states.shape[0] > HISTORY:
         raise InputError("resume state does not match the scene (degrees of freedom or contacts)")
+    if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
+        raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
 
 
 # Steps run interpreted to measure a cold run's per-step cost before deciding whether to compile.
@@ -168,9 +174,10 @@ def compiled_part(solver: str, solver_code, callback: bool):
     return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []  # callbacks run it step by step
 
 
-def _calls_back(scene) -> bool:
-    """True when a step needs Python: a Python applied_force or a Python (Prescribed) motion."""
-    return scene.applied_force is not None or scene.python_motions()
+def _python_motions(packed) -> list:
+    """The packed motions when one of them is a Python (Prescribed) one (each step evaluates
+    them from Python), else []."""
+    return packed.motions if any(isinstance(m, Prescribed) for m in packed.motions) else []
 
 
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
@@ -239,14 +246,8 @@ class MoreauJean:
         """From (q0, v0) at t0 (or the end state `resume` of an earlier run) to exactly t_end,
         keeping one sample per `save_every` (default: every step); `stop`: callables (t, q, v)
         tried at each kept sample, ending the run at the first that holds."""
-        if not t_end > t0:
-            raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
         opts, names = self.options, [c.name for c in scene.contacts]
-        q0, v0 = require_state("q0", q0, scene.n_dof), require_state("v0", v0, scene.n_dof)
-        if resume is not None:
-            _check_resume(resume, scene.n_dof, len(names))
-            if not (np.array_equal(q0, resume.q[-1]) and np.array_equal(v0, resume.v[-1])):
-                raise InputError("resume: q0 and v0 must be the end state's (resume.q[-1], resume.v[-1])")
+        q0, v0 = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)  # checked by the driver
         if opts.tol is not None:
             return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop, names)
         grid = Grid.of(opts.h, t0, t_end, resume)
@@ -258,33 +259,31 @@ class MoreauJean:
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         params, iparams = self._parameters(scene, grid, names)
         solver_code = COMPILED_SOLVERS.get(opts.solver)
-        engine = Engine(bool(opts.fast and _jit.ENABLED),
-                        *compiled_part(opts.solver, solver_code, _calls_back(scene)))
-        self._solver_error, self._packed = None, packed
+        # a step needs Python: a Python applied_force or a Python (Prescribed) motion
+        self._motions_in_python = _python_motions(packed)
+        self._calls_back = scene.applied_force is not None or bool(self._motions_in_python)
+        engine = Engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
+        self._solver_error = None
         wall = time.process_time()
         with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
             ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop))
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": engine.compiled and solver_code is not None,
-                 "force_callback": _calls_back(scene)}
+                 "force_callback": self._calls_back}
         return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
         """The error-controlled run (integrators/adaptive.py) on this integrator's loop and kernels."""
         from .adaptive import run_adaptive
 
-        if scene.joints or scene.driven_things():
-            what = f"joint {scene.joints[0].name!r}" if scene.joints else scene.driven_things()[0] + " (driven)"
-            raise InputError(f"tol: error control does not handle joints or driven obstacles and bodies yet ({what}); "
-                             "give a fixed step h instead")
         packed = pack_scene(scene)
         model, work = _model_and_work(packed, resume)
         params, iparams = self._parameters(scene, Grid.of(self.options.h, t0, t_end, None), names)
         engine = Engine(bool(self.options.fast and _jit.ENABLED),
                         *compiled_part(self.options.solver, COMPILED_SOLVERS.get(self.options.solver),
                                        scene.applied_force is not None))
-        self._solver_error = None
+        self._solver_error, self._motions_in_python = None, []  # tol: no driven motions (declares)
         with _jit.one_blas_thread():
             return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
                                 model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
@@ -352,7 +351,7 @@ class MoreauJean:
         counters[loop.K_DONE] = r0
         kernels = engine.kernels
         with engine.compiling():
-            if not _calls_back(scene) and iparams[loop.I_SOLVER] >= 0:
+            if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
                 status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
             else:
                 status = self._run_stepwise(kernels, scene, r0, r0 + n, params, iparams, model, work, out)
@@ -377,7 +376,7 @@ class MoreauJean:
         q, v, counters = out[0], out[1], out[9]
         f, extra = np.empty(scene.n_dof), np.zeros(scene.n_dof)
         compiled = int(iparams[loop.I_SOLVER]) >= 0  # an exact solver: the compiled loop, one step a call
-        motions = self._packed.motions if scene.python_motions() else ()
+        motions = self._motions_in_python
         for k in range(r_start, r_end):
             if motions:
                 t = kernels.step_time(params, k)
@@ -476,7 +475,7 @@ class MoreauJean:
         impacts, events = self._impacts(scene, grid, collector, names)
         counters = window.out[9]
         t, q, v, a, N, T, codes = collector.trajectory_arrays()
-        modes = np.array(STATE_NAMES, dtype=object)[codes]
+        modes = _STATE_WORDS.take(codes)
         if k_end == grid.first and collector.resume is None:
             modes[:] = "open"
         t_stop = None
@@ -506,6 +505,21 @@ class MoreauJean:
         result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
         return result
 
+
+def _tol_with_joints_or_driven(scene, options, duration) -> dict | None:
+    if options.tol is None:
+        return None
+    found = first_joint(scene) or first_driven(scene)
+    return None if found is None else {"item": found["item"] + ("" if scene.joints else " (driven)")}
+
+
+MoreauJean.declares = Declaration(
+    options=MoreauJeanOptions,
+    contacts=("DiskOnLine", "DiskOnDisk", "DiskOnSegment", "SegmentEndOnEdge", "VertexOnEdge"),
+    samples_estimate=MoreauJean.samples_estimate, samples_knob=MoreauJean.SAMPLES_KNOB,
+    refusals=(Refusal(_tol_with_joints_or_driven, "tol: error control does not handle joints or driven obstacles "
+                                                  "and bodies yet ({item}); give a fixed step h instead"),),
+    absolute_time=True, resumes=check_resume, compiles=lambda options: options.fast)
 
 def joint_forces(joints, impulses_over_h) -> dict:
     """{joint name: {reaction: samples}}: a pin's world force (Fx, Fy) on body_a, a slider's force

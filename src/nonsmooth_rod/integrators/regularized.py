@@ -50,7 +50,8 @@ from scipy.optimize import brentq
 from ..model.contacts import DiskOnLine
 from ..model.scene import Scene
 from ..results import Event, Impact, SimulationResult, Trajectory, merge_short_phases, Phase
-from ..validation import Choice, InputError, Number, Text, check_options, option, require_positive
+from ..validation import Choice, InputError, Number, Text, check_options, option
+from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration
 from .event_driven import ATOL_CEILING, RTOL_FLOOR
 
 FRICTION_CURVES = ("stribeck", "tanh", "linear")
@@ -276,7 +277,6 @@ class Regularized:
             return self._run(scene, q0, v0, t_end)
 
     def _run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        require_positive("t_end", t_end)
         solver, rec = self._start(scene, q0, v0, t_end)
         try:
             while solver.status == "running" and rec.status == "ok" and rec.t_stop is None:
@@ -289,9 +289,6 @@ class Regularized:
     def _start(self, scene: Scene, q0, v0, t_end: float):
         """The ODE solver at t = 0 and the record of the run (samples, states, events)."""
         o = self.options
-        for c in scene.contacts:
-            if not isinstance(c, DiskOnLine):
-                raise InputError("the regularised integrator handles disk/point-on-line contacts only")
         self._scene = scene
         self._n_dof = n = scene.n_dof
         self._minv = scene.inverse_mass_diagonal
@@ -431,3 +428,8 @@ class Regularized:
                 modes[k, ci] = self._state_of(gap, u_T)
         self._deadline = deadline
         return Trajectory(np.array(ts, dtype=float), ys[:, :n].copy(), ys[:, n:].copy(), a, N, T, modes)
+
+
+Regularized.declares = Declaration(
+    options=RegularizedOptions, contacts=("DiskOnLine",), samples_estimate=Regularized.samples_estimate,
+    samples_knob=Regularized.SAMPLES_KNOB, refusals=(NO_JOINTS, NO_DRIVEN, STEP_CAP))

@@ -110,12 +110,6 @@ class Scene:
         names = [f"contact {c.name!r}" for c in self.contacts if getattr(c, "obstacle_motion", None) is not None]
         return names + [f"body {self.bodies[d.body].name!r}" for d in self.driven]
 
-    def python_motions(self) -> bool:
-        """True when a driven obstacle or body follows a Python (Prescribed) motion."""
-        from .motion import Prescribed
-
-        motions = [getattr(c, "obstacle_motion", None) for c in self.contacts] + [d.motion for d in self.driven]
-        return any(isinstance(m, Prescribed) for m in motions)
     def _check_joints(self) -> None:
         """Joints are Pin or Slider on bodies that exist, with unique names."""
         from .joints import JOINT_TYPES
