@@ -3,6 +3,7 @@
     moreau-jean    time-stepping at velocity level, one contact problem per step (any scene)
     event-driven   smooth modes joined by located events (disks and points on lines)
     regularized    smooth friction and penalty contact integrated by a scipy ODE solver
+    hybrid         fixed explicit Runge–Kutta steps in each smooth mode, the event-driven events
 
 An integrator is a class with `name`, an options dataclass, and
 `run(scene, q0, v0, t_end) -> SimulationResult`; the table below also declares which contact
@@ -25,6 +26,7 @@ METHODS = {
                                                                              "SegmentEndOnEdge", "VertexOnEdge")),
     "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine",)),
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
+    "hybrid": ("hybrid", "Hybrid", "HybridOptions", ("DiskOnLine",)),
 }
 
 # The methods that run driven obstacles and bodies (model/motion.py). The event-driven reference
