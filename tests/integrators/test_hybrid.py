@@ -99,3 +99,20 @@ def test_bad_options_are_refused(options, field):
     q0, v0 = toy.initial_state()
     with pytest.raises(InputError, match=field):
         nr.simulate(toy.scene(), q0, v0, 1.0, "hybrid", **options)
+
+
+def test_rocking_block_impacts_at_housners_ratio():
+    """Housner's block (α = 41°, e = 0) at h = 1e-2: every impact while |θ̇| ≥ 0.05 rad/s at the
+    reference's time (1e-6 s) with Housner's velocity ratio 1 − 1.5 sin²α (1e-6)."""
+    from nonsmooth_rod import toys
+
+    toy = toys.RockingBlock(half_width=0.3 * math.tan(math.radians(41.0)), half_height=0.3)
+    q0, v0 = toy.initial_state()
+    reference = nr.simulate(toy.scene(), q0, v0, 1.0, "event-driven", rtol=1e-11, atol=1e-11)
+    run = nr.simulate(toy.scene(), q0, v0, 1.0, "hybrid", h=1e-2)
+    pairs = [(t, before, after) for t, before, after in toys.impact_rate_pairs(run) if abs(before) >= 0.05]
+    assert len(pairs) == 4  # |θ̇| 1.95, 0.69, 0.24, 0.087 rad/s: each the ratio times the one before
+    ref_times = [imp.t for imp in reference.impacts]
+    for k, (t, before, after) in enumerate(pairs):
+        assert abs(t - ref_times[k]) <= 1e-6
+        assert abs(abs(after / before) - toy.ratio) <= 1e-6
