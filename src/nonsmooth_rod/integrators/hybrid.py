@@ -84,12 +84,10 @@ def _hermite(a: _Stage, b: _Stage):
     """The step's cubic Hermite interpolant of (q, v) from both ends' (q, v) and (v, a)."""
     h = b.t - a.t
 
-    def dense(t):
-        s = (np.asarray(t, dtype=float) - a.t) / h
+    def dense(t: float) -> np.ndarray:
+        s = (t - a.t) / h
         h00, h10 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2
         h01, h11 = s * s * (3 - 2 * s), s * s * (s - 1)
-        if np.ndim(s):
-            return (np.outer(a.y, h00) + np.outer(b.y, h01) + h * (np.outer(a.f, h10) + np.outer(b.f, h11)))
         return h00 * a.y + h01 * b.y + h * (h10 * a.f + h11 * b.f)
     return dense
 
@@ -128,7 +126,6 @@ class _StepWatch(_Watch):
             if t_cross is not None:
                 found.append((t_cross, j))
         return _first_of(found, self.indicators)
-
 
     def _leave_start_band(self, j, nodes_t, nodes_s, dense):
         """An indicator starting at zero (a corner lifting off at an impact) may leave to the safe
