@@ -1,12 +1,14 @@
 """Housner's rocking block (e = 0) with error control against the event-driven reference (issue 28).
 
-    python benchmarks/bench_rocking.py [--quick] [--tol TOL] [--out DIR]
+    python benchmarks/bench_rocking.py [--quick] [--tol TOL | --hybrid H] [--out DIR]
 
 For slenderness α = 11° … 41° (half-height 0.3 m, tilt 10°, 3 s): the impacts of the reference
 (rtol = atol = 1e-11) and of Moreau–Jean with `tol` (default 1e-6), the time of each one's last
 impact, the ratio |θ̇⁺/θ̇⁻| − (1 − 1.5 sin²α) at the first five impacts, and the first impact
 where it is off by more than 1e-4 with its |θ̇⁻|. Writes DIR/rocking.csv and prints markdown
-(docs/error_control.md quotes it). --quick: α = 41° only (a test runs it).
+(docs/error_control.md quotes it). --quick: α = 41° only (a test runs it). --hybrid H: the hybrid
+method (Runge–Kutta of order 4 between events, integrators/hybrid.py) at step H instead of tol
+(evaluations: its steps).
 """
 from __future__ import annotations
 
@@ -35,16 +37,17 @@ def ratio_errors(toy: toys.RockingBlock, result) -> list[tuple[float, float]]:
     return [(abs(before), abs(abs(after / before) - toy.ratio)) for _, before, after in toys.impact_rate_pairs(result)]
 
 
-def measure(alpha_deg: float, tol: float) -> dict:
+def measure(alpha_deg: float, tol: float, hybrid_h: float | None = None) -> dict:
     toy = block(alpha_deg)
     q0, v0 = toy.initial_state()
     reference = nr.simulate(toy.scene(), q0, v0, T_END, "event-driven", rtol=1e-11, atol=1e-11)
-    run = nr.simulate(toy.scene(), q0, v0, T_END, "moreau-jean", tol=tol)
+    run = (nr.simulate(toy.scene(), q0, v0, T_END, "moreau-jean", tol=tol) if hybrid_h is None
+           else nr.simulate(toy.scene(), q0, v0, T_END, "hybrid", h=hybrid_h))
     errors = ratio_errors(toy, run)
     off = next((k for k, (_, e) in enumerate(errors) if e > RATIO_TOL), None)
     return {"alpha_deg": alpha_deg, "reference_impacts": len(reference.impacts),
             "reference_last_s": reference.impacts[-1].t, "impacts": len(run.impacts), "last_s": run.impacts[-1].t,
-            "evaluations": run.stats["step_evaluations"],
+            "evaluations": run.stats.get("step_evaluations", run.steps),
             "ratio_error_first5_max": max(e for _, e in errors[:5]),
             "first_off": -1 if off is None else off + 1, "first_off_rate": math.nan if off is None else errors[off][0]}
 
@@ -53,13 +56,15 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--tol", type=float, default=1e-6)
+    parser.add_argument("--hybrid", type=float, default=None, metavar="H")
     parser.add_argument("--out", default="benchmark")
     args = parser.parse_args(argv)
-    rows = [measure(a, args.tol) for a in ALPHAS["quick" if args.quick else "full"]]
+    rows = [measure(a, args.tol, args.hybrid) for a in ALPHAS["quick" if args.quick else "full"]]
+    run_name = f"tol = {args.tol:g}" if args.hybrid is None else f"hybrid h = {args.hybrid:g}"
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "rocking.csv", {c: [r[c] for r in rows] for c in COLUMNS}, COLUMNS)
-    print(f"| α | reference impacts (last, s) | tol = {args.tol:g} impacts (last, s) | evaluations | "
+    print(f"| α | reference impacts (last, s) | {run_name} impacts (last, s) | evaluations | "
           f"ratio error, first 5 | first impact off by > {RATIO_TOL:g} (its |θ̇|) |\n|---|---|---|---|---|---|")
     for r in rows:
         off = "none" if r["first_off"] < 0 else f"#{r['first_off']} ({r['first_off_rate']:.1e} rad/s)"

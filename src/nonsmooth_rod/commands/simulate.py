@@ -26,10 +26,11 @@ def register(subparsers) -> None:
     add_physics_options(sim)
     num = sim.add_argument_group("numerics")
     num.add_argument("--method", default="event-driven",
-                     help="event-driven (default), moreau-jean, or the baselines regularized and switched")
+                     help="event-driven (default), moreau-jean, hybrid (Runge–Kutta steps of --h between "
+                          "located events), or the baselines regularized and switched")
     num.add_argument("--h", type=number, default=None,
                      help="Moreau–Jean step size, s (default 1e-4); with --tol the first and largest step "
-                          "(default 1e-2)")
+                          "(default 1e-2); hybrid: its step (default 1e-2)")
     num.add_argument("--tol", type=number, default=None,
                      help="Moreau–Jean error control: step sizes chosen for this tolerance on positions (m, rad) "
                           "and on located event times (s); docs/error_control.md")

@@ -3,6 +3,7 @@
     moreau-jean    time-stepping at velocity level, one contact problem per step (any scene)
     event-driven   smooth modes joined by located events (disks and points on lines)
     regularized    smooth friction and penalty contact integrated by a scipy ODE solver
+    hybrid         fixed explicit Runge–Kutta steps in each smooth mode, the event-driven events
 
 An integrator is a class with `name`, `declares` (integrators/declaration.py: its options
 dataclass, the contact relations it runs, what else it refuses and why, how many samples a run
@@ -25,6 +26,7 @@ METHODS = {
     "moreau-jean": ("moreau_jean", "MoreauJean"),
     "event-driven": ("event_driven", "EventDriven"),
     "regularized": ("regularized", "Regularized"),
+    "hybrid": ("hybrid", "Hybrid"),
 }
 _CLASSES: dict = {}  # method name → its integrator class, imported once per process
 

@@ -141,12 +141,12 @@ def _indicators(scene, modes, force_tol: float) -> list[_Indicator]:
     return out
 
 
-def _indicator_values(scene, modes, indicators, t, y) -> np.ndarray:
-    """Values of the indicators at state y (the mode's dynamics are solved once, if needed)."""
+def _indicator_values(scene, modes, indicators, t, y, kin=None, dyn=None) -> np.ndarray:
+    """Values of the indicators at state y (the mode's dynamics are solved once, if needed;
+    kin and dyn: the kinematics and the mode's dynamics at y when the caller has them)."""
     n = scene.n_dof
     q, v = y[:n], y[n:]
-    kin = scene.kinematics(q, v)
-    dyn = None
+    kin = kin if kin is not None else scene.kinematics(q, v)
     out = np.empty(len(indicators))
     for j, ind in enumerate(indicators):
         k = kin[ind.contact]

@@ -17,7 +17,7 @@ from ..results import Phase, SimulationResult
 from .hypotheses import RollingHypothesis, rolling_hypothesis
 from ..validation import InputError, require_positive
 
-METHODS = ("event-driven", "moreau-jean", "regularized", "switched")
+METHODS = ("event-driven", "moreau-jean", "regularized", "switched", "hybrid")
 TRAJECTORY_COLUMNS = ("t", "theta", "theta_dot", "theta_ddot", "x_O", "x_O_dot", "x_O_ddot", "N", "T", "mode")
 SUMMARY_SCHEMA = ROD_SUMMARY_SCHEMA
 MAX_DURATION = 10.0  # s; without --t-end the run stops at ball B's impact, well before this
@@ -100,7 +100,7 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
              rtol: float | None = None, output_dt: float = 1e-3, epsilon: float = 1e-4,
              friction_curve: str = "stribeck", ode_method: str | None = None, atol: float | None = None,
              stiffness: float | None = None, damping: float | None = None,
-             time_limit: float | None = None, max_step: float | None = None) -> RodRun:
+             time_limit: float | None = None, max_step: float | None = None, order: int = 4) -> RodRun:
     """Simulate the paper's rod. Without `t_end` the run stops at ball B's impact.
 
     The rod is a Scene run by `nonsmooth_rod.simulate` (the "switched" baseline excepted: it
@@ -111,7 +111,8 @@ def simulate(problem: RodProblem | None = None, method: str = "event-driven", *,
     `ode_method` "rk4" with step h or an adaptive scipy method); h defaults to 1e-4 s, and with
     `tol` (Moreau–Jean's error control, integrators/adaptive.py) it is the first and largest step
     (default 1e-2 s); `time_limit` (wall seconds)
-    stops either with status "time-limit"; `max_step` caps the event-driven step.
+    stops either with status "time-limit"; `max_step` caps the event-driven step. "hybrid":
+    Runge–Kutta steps of h (default 1e-2 s) of `order` in each smooth mode (integrators/hybrid.py).
     """
     problem = problem or RodProblem.paper()
     if method not in METHODS:
@@ -147,6 +148,9 @@ def _method_options(method: str, a: dict) -> tuple[dict, dict]:
             options["tol"] = a["tol"]
         resolved = MoreauJeanOptions(**options)
         return options, dict(options, h=resolved.h, min_phase=resolved.min_phase)
+    if method == "hybrid" and a["tol"] is None:
+        options = {"h": 1e-2 if a["h"] is None else a["h"], "order": a["order"]}
+        return options, dict(options)
     if a["tol"] is not None:
         raise InputError(f"tol is Moreau–Jean's error control; method '{method}' has rtol and atol")
     a = dict(a, h=1e-4 if a["h"] is None else a["h"])

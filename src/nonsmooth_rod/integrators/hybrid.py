@@ -1,0 +1,229 @@
+"""Event-driven stepping at a fixed step ("hybrid"): each smooth phase integrated with explicit
+Runge–Kutta steps of h (order 2, 3 or 4) on the mode-fixed ODE, events located on the steps'
+dense output. docs/error_control.md ("A higher order between events") has the why and the
+measurements.
+
+Between events the contact modes (open, stick, slip±) are fixed and the scene is the smooth
+constrained ODE of model/dynamics.mode_dynamics: its error is C h^order, whatever the contact
+forces (Moreau–Jean, whose step holds the contacts with their Jacobian at the step's start, is
+first order there). Everything at an event is the event-driven reference's
+(integrators/event_driven.py, whose class this one extends): the switching indicators, the
+choice of the modes after a switch (stick first), the impact law at impulse level at the
+located instant, rest. Only the watch differs: the reference interpolates every indicator on 13
+Chebyshev points of each step; here each step gives three samples for free — its start, its
+end and its midpoint stage (the state y + h/2 k of the stage at t + h/2, the forces the stage
+solved for anyway) — and only a sign change, or a dip between them (a parabola through the
+three with an interior minimum at most half the smaller end value: a grazing peak of T/N inside
+the step), is looked at closely on the step's cubic Hermite interpolant (brentq, or a bounded
+minimisation then brentq). Events are located to the interpolant's accuracy, O(h⁴).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.dynamics import mode_dynamics
+from ..solvers import available_solvers
+from ..validation import Choice, Integer, Number, Text, check_options, option
+from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
+from .event_driven import (_EPS, _TINY, EventDriven, _first_of, _force_scale, _indicator_values, _indicators,
+                           _Watch)
+
+# Explicit Runge–Kutta tableaux (c, a, b) and the stage at c = 1/2 sampled for the watch:
+# the explicit midpoint rule, Kutta's third-order rule, the classical fourth-order rule.
+TABLEAUX = {
+    2: ((0.0, 0.5), ((), (0.5,)), (0.0, 1.0), 1),
+    3: ((0.0, 0.5, 1.0), ((), (0.5,), (-1.0, 2.0)), (1 / 6, 2 / 3, 1 / 6), 1),
+    4: ((0.0, 0.5, 0.5, 1.0), ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0)), (1 / 6, 1 / 3, 1 / 3, 1 / 6), 2),
+}
+# A dip of an indicator between a step's samples is looked at closely when the parabola through
+# them has an interior minimum below this fraction of the smaller end value.
+DIP_FRACTION = 0.5
+# A segment's first step is at most GROWTH times the segment before it, each next one GROWTH
+# times the one before (up to h): steps follow the time scale of accumulating events.
+GROWTH = 2.0
+# Halvings of a step's first interval looking for the side an indicator starting at zero leaves to.
+MAX_HALVINGS = 60
+
+
+@dataclass
+class HybridOptions:
+    """Step, order and the event-driven reference's event controls."""
+
+    h: float = option(1e-2, Number(0.0, 1.0, open_lo=True), label="h (step size)")
+    order: int = option(4, Integer(2, 4))
+    stop_at_impact: str | None = option(None, Text())  # name of a contact whose first impact ends the run
+    max_events: int = option(10_000, Integer(1, 10**9))
+    zeno_interval: float = option(1e-9, Number(0.0, 1e-3))  # impacts closer than this: accumulation (s)
+    impact_solver: str = option("enum", Choice(available_solvers))
+    gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
+    velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
+
+    def __post_init__(self):
+        check_options(self)
+
+    @property
+    def output_dt(self) -> float:
+        """The samples a run at rest keeps (the reference's `_hold_rest` reads it): one a step."""
+        return self.h
+
+
+class _Stage:
+    """The mode's dynamics at one state: its derivative, and what the indicators read."""
+
+    def __init__(self, scene, modes, t, y):
+        n = scene.n_dof
+        self.t, self.y = t, y
+        self.kin = scene.kinematics(y[:n], y[n:])
+        self.dyn = mode_dynamics(scene, t, y[:n], y[n:], modes, self.kin)
+        self.f = np.concatenate([y[n:], self.dyn.a])
+
+
+def _hermite(a: _Stage, b: _Stage):
+    """The step's cubic Hermite interpolant of (q, v) from both ends' (q, v) and (v, a)."""
+    h = b.t - a.t
+
+    def dense(t: float) -> np.ndarray:
+        s = (t - a.t) / h
+        h00, h10 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2
+        h01, h11 = s * s * (3 - 2 * s), s * s * (s - 1)
+        return h00 * a.y + h01 * b.y + h * (h10 * a.f + h11 * b.f)
+    return dense
+
+
+class _StepWatch(_Watch):
+    """The reference's watch (noise bands, near-miss refinement, first fall) fed with a step's
+    three samples instead of 13 Chebyshev points."""
+
+    def values(self, stage: _Stage) -> np.ndarray:
+        self.evaluations += 1
+        return self.sign * _indicator_values(self.scene, self.modes, self.indicators, stage.t, stage.y,
+                                             stage.kin, stage.dyn)
+
+    def first_event_sampled(self, dense, ts, s):
+        """(t, j): the first crossing in [ts[0], ts[-1]] given the safe values s (3 × indicators)."""
+        found = []
+        for j in range(len(self.indicators)):
+            column = s[:, j].copy()
+            self._start_band(j, ts, column)
+            vertex = _parabola_minimum(ts, column)
+            dip = vertex is not None and vertex[1] <= DIP_FRACTION * min(column[0], column[-1])
+            if min(column) > 0.0 and not dip:
+                continue
+            # Looked at closely on the interpolant: the middle sample (a stage's state, not the
+            # interpolant's) is taken again from it, so that the brackets are the root finder's.
+            column[1] = self.safe_values(ts[1], dense)[j]
+            nodes_t, nodes_s = list(ts), list(column)
+            if dip and min(column) > 0.0:
+                k = 1 if vertex[0] <= ts[1] else 2
+                nodes_t.insert(k, vertex[0])
+                nodes_s.insert(k, self.safe_values(vertex[0], dense)[j])
+            self._start_band(j, nodes_t, nodes_s)
+            self._refine_near_misses(j, nodes_t, nodes_s, dense, math.inf)
+            self._leave_start_band(j, nodes_t, nodes_s, dense)
+            t_cross = self._first_fall(j, nodes_t, nodes_s, dense)
+            if t_cross is not None:
+                found.append((t_cross, j))
+        return _first_of(found, self.indicators)
+
+    def _leave_start_band(self, j, nodes_t, nodes_s, dense):
+        """An indicator starting at zero (a corner lifting off at an impact) may leave to the safe
+        side and come back within the first interval of a long step: halve that interval until a
+        node shows it safe, so that its return is located, not the start taken for it."""
+        for _ in range(MAX_HALVINGS):
+            if not (nodes_s[0] == _TINY and nodes_s[1] <= 0.0):
+                return
+            t_half = 0.5 * (nodes_t[0] + nodes_t[1])
+            if t_half - nodes_t[0] <= 1e3 * _EPS * max(1.0, abs(t_half)):
+                return
+            nodes_t.insert(1, t_half)
+            nodes_s.insert(1, self.safe_values(t_half, dense)[j])
+            self._start_band(j, nodes_t, nodes_s)
+
+
+def _parabola_minimum(ts, s):
+    """(t, value) of the interior minimum of the parabola through three samples, or None."""
+    (t0, t1, t2), (s0, s1, s2) = ts, s
+    d01, d12 = (s1 - s0) / (t1 - t0), (s2 - s1) / (t2 - t1)
+    curvature = (d12 - d01) / (t2 - t0)
+    if not curvature > 0.0:
+        return None
+    t_v = 0.5 * (t0 + t1) - d01 / (2.0 * curvature)
+    if not t0 < t_v < t2:
+        return None
+    return t_v, s0 + d01 * (t_v - t0) + curvature * (t_v - t0) * (t_v - t1)
+
+
+def _first_step_cap(boundaries: list) -> float:
+    """The first step of a segment: at most GROWTH times the segment before (steps then grow by
+    GROWTH each up to h). Impacts accumulating (a rocking block's, a bouncing ball's) come ever
+    closer; steps of h would locate them to the interpolant's absolute error (~1e-9 m at
+    h = 1e-2), far above their amplitudes, and the chain would end in a false Zeno."""
+    return GROWTH * (boundaries[-1] - boundaries[-2]) if len(boundaries) > 1 else math.inf
+
+
+class Hybrid(EventDriven):
+    """Fixed explicit Runge–Kutta steps in each smooth mode, the reference's events between them
+    (disks and points on lines)."""
+
+    name = "hybrid"
+
+    SAMPLES_KNOB = "a larger h, save_every or a shorter t_end"
+
+    @staticmethod
+    def samples_estimate(options, duration: float, save_every: float | None) -> float:
+        """One sample a step (the driver thins to save_every after), and one per event."""
+        return duration / options.h + 2 + options.max_events
+
+    def __init__(self, options: HybridOptions | None = None):
+        self.options = options or HybridOptions()
+
+    def _segment(self, scene, run, modes, t_end):
+        """Steps of h in `modes` from the run's state to the first event or t_end. Returns the
+        event's (kind, contact), or None at t_end; leaves the run at the stop."""
+        indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
+        start = _Stage(scene, modes, run.t, np.concatenate([run.q, run.v]))
+        watch = _StepWatch(scene, modes, indicators, start.t, start.y)
+        s_start, h = watch.values(start), self.options.h
+        cap = _first_step_cap(run.boundaries)
+        try:
+            while True:
+                step = min(h, cap, t_end - start.t)
+                if t_end - start.t < 1.01 * step:
+                    step = t_end - start.t  # no sliver of a last step
+                cap *= GROWTH
+                middle, end = self._step(scene, modes, start, step, run)
+                run.steps += 1
+                dense = _hermite(start, end)
+                ts = (start.t, middle.t, end.t)
+                hit = watch.first_event_sampled(dense, ts, np.array([s_start, watch.values(middle),
+                                                                     s_end := watch.values(end)]))
+                if hit is not None:
+                    run.close(float(hit[0]), dense(hit[0]), modes)
+                    return indicators[hit[1]].kind, indicators[hit[1]].contact
+                if end.t >= t_end:
+                    run.close(float(end.t), end.y, modes, end.dyn)
+                    return None
+                run.sample(end.t, end.y, modes, end.dyn)
+                start, s_start = end, s_end
+        finally:
+            run.indicator_evaluations += watch.evaluations
+
+    def _step(self, scene, modes, start: _Stage, h: float, run):
+        """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""
+        c, a, b, mid = TABLEAUX[self.options.order]
+        stages = [start]
+        for i in range(1, len(c)):
+            y = start.y + h * sum(a_ij * stages[j].f for j, a_ij in enumerate(a[i]) if a_ij)
+            stages.append(_Stage(scene, modes, start.t + c[i] * h, y))
+        y_end = start.y + h * sum(b_i * st.f for b_i, st in zip(b, stages) if b_i)
+        end = _Stage(scene, modes, start.t + h, y_end)
+        run.nfev += len(c)
+        return stages[mid], end
+
+
+Hybrid.declares = Declaration(
+    options=HybridOptions, contacts=("DiskOnLine",), samples_estimate=Hybrid.samples_estimate,
+    samples_knob=Hybrid.SAMPLES_KNOB, refusals=(NO_JOINTS, NO_DRIVEN))
