@@ -22,7 +22,8 @@ MAX_OUTPUT_BYTES = 4 * 2**30
 # method name → (module, integrator class, options class, contact relations it handles)
 METHODS = {
     "moreau-jean": ("moreau_jean", "MoreauJean", "MoreauJeanOptions", ("DiskOnLine", "DiskOnDisk", "DiskOnSegment",
-                                                                             "SegmentEndOnEdge", "VertexOnEdge")),
+                                                                             "SegmentEndOnEdge", "VertexOnEdge",
+                                                                             "LinearRelation")),
     "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine",)),
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
 }

@@ -117,13 +117,13 @@ class Scene:
         motions = [getattr(c, "obstacle_motion", None) for c in self.contacts] + [d.motion for d in self.driven]
         return any(isinstance(m, Prescribed) for m in motions)
     def _check_joints(self) -> None:
-        """Joints are Pin or Slider on bodies that exist, with unique names."""
+        """Joints are Pin, Slider or LinearJoint on bodies that exist, with unique names."""
         from .joints import JOINT_TYPES
 
         seen = set()
         for i, joint in enumerate(self.joints):
             if not isinstance(joint, JOINT_TYPES):
-                raise InputError(f"joints[{i}] must be a Pin or a Slider, got {type(joint).__name__}")
+                raise InputError(f"joints[{i}] must be a Pin, a Slider or a LinearJoint, got {type(joint).__name__}")
             require_name(f"joints[{i}] name", joint.name)
             if joint.name in seen:
                 raise InputError(f"two joints are named {joint.name!r}: joint names must be unique")
