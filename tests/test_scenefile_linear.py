@@ -41,7 +41,8 @@ def test_a_linear_contact_and_joint_read_from_a_file_and_run():
     k = int(np.argmax(result.v[:, 0]))  # the landing step's start: Newton's law on its velocity
     assert result.v[k + 1, 0] == pytest.approx(-0.5 * result.v[k, 0], rel=1e-12)
     assert result.v[k + 1, 1] == pytest.approx(0.5 * result.v[k + 1, 0], rel=1e-12)
-    # the rail's reaction F·row cancels the weight's part across it: −(m g·n) n = (−0.8, 1.6) N, n = (1, −2)/√5
+    # the rail's reaction F·row cancels the weight's part across it: −(m g·n) n = (−0.8, 1.6) N,
+    # n = (1, −2)/√5
     free = result.t < t_hit - 0.01
     force = result.joint_forces["rail"]["F"][free][1:] * np.array([0.5, -1.0])[:, None]
     assert force.T == pytest.approx(np.tile([-2.0 * 2 / 5, 2.0 * 4 / 5], (force.shape[1], 1)), rel=1e-9)

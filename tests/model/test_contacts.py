@@ -8,7 +8,7 @@ import pytest
 
 import nonsmooth_rod as nr
 from nonsmooth_rod.model.contacts import LinearRelation
-from nonsmooth_rod.model.packing import contact_kinematics, pack_contacts  # noqa: F401
+from nonsmooth_rod.model.packing import pack_contacts
 from nonsmooth_rod.validation import InputError
 
 G = 9.81
@@ -97,6 +97,8 @@ def test_bad_linear_relations_are_refused_in_one_line(kwargs, message):
 
 def test_an_unknown_body_and_the_event_driven_method_are_refused_in_one_line():
     contact = LinearRelation({3: (0.0, 1.0, 0.0)}, 0.0, name="lin")
+    with pytest.raises(InputError, match="contact 'lin' refers to body 3, but the scene has 1 bodies"):
+        nr.Scene([nr.RigidBody(1.0, 0.01)], [contact])
     with pytest.raises(InputError, match="lin: body index beyond the scene's 1 bodies"):
         pack_contacts([contact], 1)
     scene = nr.Scene([nr.RigidBody(1.0, 0.01)], [LinearRelation({0: (0.0, 1.0, 0.0)}, 0.0, name="lin")])

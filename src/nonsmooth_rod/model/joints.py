@@ -248,5 +248,6 @@ def joint_rows(table, q, J, C):
         C[r], C[r + 1] = c0, c1
 
 
-__all__ = ["Pin", "Slider", "LinearJoint", "JOINT_LINEAR", "JOINT_TYPES", "pack_joints", "jointed_dofs", "joint_violation", "joint_rows",
+__all__ = ["Pin", "Slider", "LinearJoint", "JOINT_LINEAR",
+           "JOINT_TYPES", "pack_joints", "jointed_dofs", "joint_violation", "joint_rows",
            "JOINT_PIN", "JOINT_SLIDER", "REACTION_NAMES", "ROWS_PER_JOINT"]
