@@ -16,7 +16,9 @@ def test_bench_woodpecker_quick(capsys):
     assert bench.main(["--quick"]) == 0
     out = capsys.readouterr().out
     periods = [float(p) for p in re.findall(r"period ([0-9.]+) s", out)]
-    assert len(periods) == 4
-    siconos, toy, linearised, exact = periods
+    assert len(periods) == 5
+    siconos, toy, toy_linearised, linearised, exact = periods
     assert abs(linearised - siconos) < 1e-3 and abs(toy - exact) < 2e-3 and exact < 0.95 * siconos
+    assert abs(toy_linearised - siconos) < 1e-2 * siconos and abs(toy_linearised - linearised) < 1e-2 * linearised
+    assert re.search(r"toy linearised.*cycle beak upper lower lower upper", out)
     assert "cycle beak upper lower lower upper" in out and "cycle beak lower lower" in out

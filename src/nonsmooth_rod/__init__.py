@@ -14,10 +14,10 @@ __version__ = "0.2.0"
 from .driver import StopAtImpact, simulate
 from .model.body import RigidBody
 from .model.contacts import (DiskOnDisk, DiskOnLine, DiskOnSegment, Line, PointOnLine, PointOnSegment, Segment,
-                             SegmentEndOnEdge, VertexOnEdge)
+                             SegmentEndOnEdge, VertexOnEdge, LinearRelation)
 from .model.collision import Disk, PairLaws, Polygon, Polyline, find_contacts
 from .model.forces import ConstantForce, Damper, RampedForce, Spring, TabulatedForce, Torque, TorsionSpring
-from .model.joints import Pin, Slider
+from .model.joints import LinearJoint, Pin, Slider
 from .model.laws import ContactLaw, CoulombFriction, NewtonImpact
 from .model.motion import DrivenBody, Harmonic, Prescribed, Tabulated
 from .model.scene import Scene
@@ -47,7 +47,7 @@ SimulationResult.animate = _animate
 
 __all__ = [
     "__version__", "simulate", "StopAtImpact", "Scene", "RigidBody", "Line", "DiskOnLine", "PointOnLine",
-    "Segment", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "VertexOnEdge",
+    "Segment", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "VertexOnEdge", "LinearRelation", "LinearJoint",
     "Polygon", "Disk", "Polyline", "PairLaws", "find_contacts",
     "DiskOnDisk", "ContactLaw", "CoulombFriction", "NewtonImpact", "SimulationResult", "Status",
     "ContactState", "Phase", "Event", "Impact", "Trajectory", "solve", "PlanarFrictionProblem",

@@ -106,8 +106,17 @@ def _law_data(law) -> dict:
     return {"mu_s": law.friction.mu_s, "mu_d": law.friction.mu_d, "restitution": law.impact.restitution}
 
 
+def _body_rows_data(row: dict, bodies) -> dict:
+    """A linear relation's or joint's row {body index: coefficients} as the scene file has it."""
+    return {bodies[b]: list(w) for b, w in row.items()}
+
+
 def _contact_data(contact, bodies, lines, segments) -> dict:
     law = _law_data(contact.law)
+    if hasattr(contact, "gap0"):  # a LinearRelation
+        return {"name": contact.name, "kind": "linear", "gap0": contact.gap0,
+                "normal": _body_rows_data(contact.normal, bodies), "tangent": _body_rows_data(contact.tangent, bodies),
+                "tangent_velocity": contact.tangent_velocity, "law": law}
     if hasattr(contact, "body_a"):
         return {"name": contact.name, "kind": "disk-on-disk", "body_a": bodies[contact.body_a],
                 "body_b": bodies[contact.body_b], "radius_a": contact.radius_a, "radius_b": contact.radius_b,
@@ -168,6 +177,8 @@ def _force_data(force, bodies) -> dict:
     import dataclasses
 
     data = {k: _plain(v) for k, v in dataclasses.asdict(force).items()}
+    if hasattr(force, "row"):  # a LinearJoint
+        data["row"] = _body_rows_data(force.row, bodies)
     for key in ("body", "body_a", "body_b"):
         if data.get(key) is not None:
             data[key] = bodies[data[key]]

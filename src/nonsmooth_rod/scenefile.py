@@ -37,7 +37,7 @@ except ModuleNotFoundError:  # Python 3.10: the backport (dependency `tomli; pyt
 SCHEMA = "nonsmooth-rod/scene/1"
 SHAPES = ("disk", "ball", "rectangle", "polygon", "rod", "rod-with-balls")
 CONTACT_KINDS = ("disk-on-line", "point-on-line", "disk-on-disk", "disk-on-segment", "point-on-segment",
-                 "segment-end-on-edge")
+                 "segment-end-on-edge", "linear")
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_+\-]{1,200}")  # fullmatch: no trailing newline
 OVERLAP_TOLERANCE = 1e-9  # m per metre of the scene's size: penetration allowed in the initial state
 _REQUIRED = object()
@@ -61,6 +61,7 @@ CONTACT_KEYS = {
     "disk-on-segment": ("kind", "name", "body", "offset", "radius", "segment", "law"),
     "point-on-segment": ("kind", "name", "body", "offset", "segment", "law"),
     "segment-end-on-edge": ("kind", "name", "body", "segment", "end", "edge_start", "edge_end", "law"),
+    "linear": ("kind", "name", "gap0", "normal", "tangent", "tangent_velocity", "law"),
 }
 FORCE_KEYS = {
     "spring": ("kind", "name", "body", "point", "body_b", "point_b", "stiffness", "rest_length", "damping"),
@@ -71,9 +72,10 @@ FORCE_KEYS = {
     "torsion-spring": ("kind", "name", "body", "body_b", "stiffness", "rest_angle_deg", "damping"),
     "torque": ("kind", "name", "body", "torque"),
 }
-JOINT_KINDS = ("pin", "slider")
+JOINT_KINDS = ("pin", "slider", "linear")
 JOINT_KEYS = {"pin": ("kind", "name", "body_a", "point_a", "body_b", "point_b"),
-              "slider": ("kind", "name", "body_a", "point_a", "body_b", "point_b", "axis", "angle_deg")}
+              "slider": ("kind", "name", "body_a", "point_a", "body_b", "point_b", "axis", "angle_deg"),
+              "linear": ("kind", "name", "row", "constant")}
 
 
 @dataclass
@@ -428,6 +430,30 @@ def _contact(w, t, key, name, kind, body_names, lines):
     return DiskOnLine(body, _vector(w, t, "offset", key, 2, [0.0, 0.0]), line, radius, law, name)
 
 
+def _body_rows(w, t, name, key, body_names, required=True) -> dict:
+    """A linear relation's or joint's row: a table {body name: [x, y, θ coefficients]} → {index: tuple}."""
+    table = t.get(name, _REQUIRED if required else {})
+    full = _join(key, name)
+    if table is _REQUIRED:
+        raise w.error(full, "missing (a table { <body> = [x, y, theta coefficients] } is required)")
+    if not isinstance(table, dict):
+        raise w.error(full, f"must be a table {{ <body> = [x, y, theta coefficients] }}, got {quoted(table)}")
+    return {_lookup(w, body_names, body, f"{full}.{body}", "body"): _vector(w, table, body, full, 3)
+            for body in table}
+
+
+def _linear_contact(w, t, key, name, body_names):
+    """A contact with the gap gap0 + Σ normal.<body>·(x, y, θ) and the constant tangent row."""
+    from .model.contacts import LinearRelation
+
+    normal, tangent = _body_rows(w, t, "normal", key, body_names), _body_rows(w, t, "tangent", key, body_names, False)
+    try:
+        return LinearRelation(normal, _number(w, t, "gap0", key), tangent, _law(w, t, key), name,
+                              _number(w, t, "tangent_velocity", key, 0.0))
+    except InputError as err:
+        raise w.error(key, str(err)) from None
+
+
 def _contacts(w, data, body_names, lines, segments=None) -> list:
     contacts = []
     for name, t in _items(w, data, "contacts"):
@@ -438,6 +464,8 @@ def _contacts(w, data, body_names, lines, segments=None) -> list:
             contacts.append(_segment_contact(w, t, key, name, kind, body_names, segments or {}))
         elif kind == "segment-end-on-edge":
             contacts.append(_segment_end_contact(w, t, key, name, body_names, segments or {}))
+        elif kind == "linear":
+            contacts.append(_linear_contact(w, t, key, name, body_names))
         else:
             contacts.append(_contact(w, t, key, name, kind, body_names, lines))
     return contacts
@@ -530,6 +558,16 @@ def _forces(w, data, body_names) -> list:
 
 # --- joints ------------------------------------------------------------------------------------------
 
+def _linear_joint(w, t, key, name, body_names):
+    """constant + Σ row.<body>·(x, y, θ) = 0."""
+    from .model.joints import LinearJoint
+
+    try:
+        return LinearJoint(_body_rows(w, t, "row", key, body_names), _number(w, t, "constant", key, 0.0), name)
+    except InputError as err:
+        raise w.error(key, str(err)) from None
+
+
 def _joints(w, data, body_names) -> list:
     from .model.joints import Pin, Slider
 
@@ -538,6 +576,9 @@ def _joints(w, data, body_names) -> list:
         key = f"joints.{name}"
         kind = _text(w, t, "kind", key, choices=JOINT_KINDS)
         _check_keys(w, t, JOINT_KEYS[kind], key)
+        if kind == "linear":
+            joints.append(_linear_joint(w, t, key, name, body_names))
+            continue
         body = _lookup(w, body_names, t.get("body_a"), f"{key}.body_a", "body")
         ends = {"body_a": body, "point_a": _vector(w, t, "point_a", key, 2, [0.0, 0.0]),
                 "body_b": _other_body(w, t, key, body, body_names),

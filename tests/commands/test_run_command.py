@@ -38,7 +38,8 @@ def test_every_shipped_scene_has_a_test():
     tested = {"bouncing_ball", "block_on_incline", "pushed_block", "disk_on_incline", "belt_oscillator",
               "rocking_block", "painleve_rod", "ladder", "ball_collisions", "paper_rod", "ball_off_table",
               "box_off_table", "pendulum_wall", "shaken_block", "dominoes",
-              "woodpecker", "slider_crank"}  # (the last two: tests/toys, file = toy to 1e-12)
+              "woodpecker", "woodpecker_linearised",
+              "slider_crank"}  # (the last three: tests/toys, file = toy to 1e-12)
     assert {p.stem for p in SCENES.glob("*.toml")} == tested
 
 

@@ -1,6 +1,8 @@
 """Glocker's woodpecker toy: the published three-coordinate model against Siconos' reference run,
 and the toy's planar scene (sleeve, carriage, bird; a slider and two pins) against that model
-with the exact geometry, both integrated independently (toys/woodpecker_reduced.py)."""
+with the exact geometry, both integrated independently (toys/woodpecker_reduced.py); the same
+scene linearised as published (geometry="linearised": LinearRelation contacts with the published
+rows, a LinearJoint hinge) against Siconos' run and the linearised model."""
 import math
 
 import numpy as np
@@ -80,6 +82,49 @@ def test_while_the_sleeve_sticks_the_bird_swings_about_a_fixed_hinge(toy_cycle):
     assert np.max(np.abs(measured - expected)) < 50 * H * np.max(np.abs(closed_form))
 
 
+# At h = 1e-4 the linearised toy's cycles alternate between 0.1444 and 0.1467 s (a second landing of
+# the lower edge, taken or not: a step-sized event); from h = 5e-5 every cycle has Siconos' closings
+# (0.1455/0.1462 s; 0.1457–0.1459 s at 2e-5: benchmarks/bench_woodpecker.py).
+H_LINEARISED = 5e-5
+
+
+@pytest.fixture(scope="module")
+def linearised_run():
+    toy = Woodpecker(geometry="linearised")
+    result = nr.simulate(toy.scene(), *toy.initial_state(), T_END, "moreau-jean", h=H_LINEARISED)
+    assert result.status == "ok"
+    return result, limit_cycle(result)
+
+
+def test_the_engine_runs_the_published_model_to_siconos_limit_cycle(linearised_run, toy_cycle):
+    """Every cycle within 1 % of the period of Siconos' run (0.14606 s; 0.4 % measured) with its
+    closings, and of the three-coordinate linearised model's (two first-order schemes); the beak's
+    impacts within 1 ms of Siconos' (0.7 ms measured)."""
+    result, cycle = linearised_run
+    siconos_period = SICONOS["beak_times"][1] - SICONOS["beak_times"][0]
+    siconos_drop = SICONOS["heights"][0] - SICONOS["heights"][1]
+    reference = _reduced_cycle(linear=True)
+    assert len(cycle.periods) == len(reference.periods) == 2
+    assert cycle.beak_times[:2] == pytest.approx(SICONOS["beak_times"], abs=1e-3)
+    assert cycle.periods == pytest.approx(siconos_period, rel=1e-2)
+    assert cycle.periods == pytest.approx(reference.periods, rel=1e-2)
+    assert cycle.sequences == [SICONOS["sequence"]] * 2
+    assert cycle.descents == pytest.approx(siconos_drop, rel=3e-2)  # 19.0 and 19.7 against 19.48 mm
+    assert np.all(cycle.periods > 1.08 * toy_cycle[1].periods)  # the exact geometry's: 11 % shorter
+
+
+def test_the_linearised_toy_holds_its_linear_hinge_and_the_bird_never_moves_sideways(linearised_run):
+    """The LinearJoint keeps y_bird = y + l_M φ_M + l_G φ_S to round-off; nothing pushes the bird
+    sideways (the published mass matrix has no horizontal motion of it)."""
+    result, _ = linearised_run
+    toy = Woodpecker(geometry="linearised")
+    y, phi_m, phi_s = Woodpecker.coordinates(result).T
+    bird_y = result.q[:, 3 * 2 + 1]
+    scale = np.max(np.abs(result.q))
+    assert np.max(np.abs(bird_y - y - toy.hinge_offset * phi_m - toy.bird_offset * phi_s)) < 1e-14 * scale * 100
+    assert np.ptp(result.q[:, 6]) == 0.0 and np.max(np.abs(result.v[:, 6])) == 0.0
+
+
 def test_the_jam_angle_is_where_the_lower_edge_meets_the_pole():
     toy = Woodpecker()
     a = toy.jam_angle
@@ -89,17 +134,18 @@ def test_the_jam_angle_is_where_the_lower_edge_meets_the_pole():
 
 
 @pytest.mark.parametrize("field, value", [("sleeve_radius", 0.002), ("bird_mass", 0.0), ("mu", -0.1),
-                                          ("start", (0.0, 0.1))])
+                                          ("start", (0.0, 0.1)), ("geometry", "linear")])
 def test_bad_parameters_are_refused_naming_the_field(field, value):
     with pytest.raises(nr.InputError, match=field):
         Woodpecker(**{field: value})
 
 
-def test_the_example_scene_file_is_the_toy():
+@pytest.mark.parametrize("name, geometry", [("woodpecker", "exact"), ("woodpecker_linearised", "linearised")])
+def test_the_example_scene_file_is_the_toy(name, geometry):
     from pathlib import Path
 
-    sf = nr.load_scene(Path(__file__).resolve().parents[2] / "examples" / "scenes" / "woodpecker.toml")
-    toy = Woodpecker()
+    sf = nr.load_scene(Path(__file__).resolve().parents[2] / "examples" / "scenes" / f"{name}.toml")
+    toy = Woodpecker(geometry=geometry)
     q0, v0 = toy.initial_state()
     assert sf.q0 == pytest.approx(q0, abs=1e-15) and sf.v0 == pytest.approx(v0, abs=1e-15)
     from_file = nr.simulate(sf.scene, sf.q0, sf.v0, 0.1, "moreau-jean", h=H)

@@ -163,10 +163,12 @@ def constrained_delassus(na, active, hn, ht, index, minv, slot, WC, W):
 
 
 @jit
-def held_contact_rows(na, active, states, hn, ht, index, slot, rows, bodies):
+def held_contact_rows(na, active, states, touching, hn, ht, index, slot, rows, bodies):
     """The contact rows the position projection must not move (rows, bodies filled; returns their
-    count): of the contacts closed this step on a jointed body, the normal row, and the tangent
-    row of a sticking one."""
+    count): of the contacts closed this step on a jointed body — loaded, or `touching` (active,
+    unloaded, yet ending the step at their obstacle: an unloaded pair of a slider's corners on
+    its guide, which the projection would otherwise push into the guide or away from it) — the
+    normal row, and the tangent row of a sticking one."""
     m = 0
     for a in range(na):
         i = active[a]
@@ -174,7 +176,7 @@ def held_contact_rows(na, active, states, hn, ht, index, slot, rows, bodies):
         for side in range(2):
             body = index[i, CI_BODY_A + side]
             jointed = jointed or (body >= 0 and slot[3 * body] >= 0)
-        if states[a] == STATE_OPEN or not jointed:
+        if (states[a] == STATE_OPEN and not touching[a]) or not jointed:
             continue
         for which in range(2 if states[a] == STATE_STICK else 1):
             rows[m, :] = hn[i] if which == 0 else ht[i]

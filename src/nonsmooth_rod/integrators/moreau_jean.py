@@ -515,7 +515,8 @@ def _tol_with_joints_or_driven(scene, options, duration) -> dict | None:
 
 MoreauJean.declares = Declaration(
     options=MoreauJeanOptions,
-    contacts=("DiskOnLine", "DiskOnDisk", "DiskOnSegment", "SegmentEndOnEdge", "VertexOnEdge"),
+    contacts=("DiskOnLine", "DiskOnDisk", "DiskOnSegment", "SegmentEndOnEdge", "VertexOnEdge",
+              "LinearRelation"),
     samples_estimate=MoreauJean.samples_estimate, samples_knob=MoreauJean.SAMPLES_KNOB,
     refusals=(Refusal(_tol_with_joints_or_driven, "tol: error control does not handle joints or driven obstacles "
                                                   "and bodies yet ({item}); give a fixed step h instead"),),

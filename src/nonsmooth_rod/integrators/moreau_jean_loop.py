@@ -529,7 +529,8 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
         q[k + 1, d] = qk[d] + h * ((1.0 - theta) * vk[d] + theta * v_next[d])
         finite = finite and math.isfinite(q[k + 1, d]) and math.isfinite(v_next[d])
     if jointed and finite:
-        _joints_project(q[k + 1], na, states, active, hn, ht, index, minv, joints, joint_buffer)
+        _joints_project(q[k + 1], na, states, active, hn, ht, index, minv, joints, joint_buffer, params, gaps, drifts,
+                        a_free, table, v_next)
     status = RUN_OK
     broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # as begin_arrays' broad phase
     for i in range(table.shape[0]):
@@ -602,12 +603,19 @@ def _joints_finish(v_next, minv, table, buffer, impulse):
 
 
 @jit
-def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buffer):
+def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buffer, params, gaps, drifts, a_free,
+                    contacts, v_next):
     """q_{k+1} projected back onto the joints' positions C(q) = 0 (their drift stays round-off),
-    the contacts that held this step kept where they are."""
+    the contacts that held this step — loaded, or unloaded but still at their obstacle
+    (_rides_the_gap) — kept where they are."""
     _, slot, J, C, _, _, _ = _joint_state(minv, table, buffer)
     held, held_bodies = np.empty((2 * na, 6)), np.empty((2 * na, 2), dtype=np.int64)
-    n_held = held_contact_rows(na, active, states, hn, ht, index, slot, held, held_bodies)
+    touching = np.zeros(na, dtype=np.int64)
+    for a in range(na):
+        if states[a] == STATE_OPEN and _rides_the_gap(active[a], params, gaps, drifts, hn, ht, a_free, contacts,
+                                                      index, v_next):
+            touching[a] = 1
+    n_held = held_contact_rows(na, active, states, touching, hn, ht, index, slot, held, held_bodies)
     project_positions(q_next, minv, table, J, C, held, held_bodies, n_held)
 
 

@@ -54,7 +54,13 @@ C_MOTION, C_BASE_PX, C_BASE_PY, C_OBSTACLE_VX, C_OBSTACLE_VY, C_OBSTACLE_START_V
 # edges a point has crossed, only the least penetrated one is its pair (separating axes, locally):
 # a segment's end resting on a box's side is not also a deep contact on the box's top.
 C_PREV_NX, C_PREV_NY, C_NEXT_NX, C_NEXT_NY = range(32, 36)
-N_CONTACT_COLUMNS = 36
+# A linear relation (Siconos' LagrangianLinearTIR): gap g0 + w_N·q and tangent row w_T, both
+# constant, over the 6 coordinates (x, y, θ of body a, then of body b): w_N in C_LINEAR_N +
+# 0..5, w_T in C_LINEAR_T + 0..5, g0 in C_LINEAR_GAP0 (a constant tangential drift is
+# C_SURFACE_VELOCITY, as a belt's).
+KIND_LINEAR = 6
+C_LINEAR_N, C_LINEAR_T, C_LINEAR_GAP0 = 36, 42, 48
+N_CONTACT_COLUMNS = 49
 
 
 @jitable
@@ -307,6 +313,20 @@ def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
 
 
 @jitable
+def _linear_relation(row, body_a, body_b, q, hn, ht):
+    """g0 + w_N·q with the constant rows w_N, w_T: no drift (Ḣ = 0)."""
+    gap = row[C_LINEAR_GAP0]
+    for side in range(2):
+        body = body_a if side == 0 else body_b
+        for d in range(3):
+            k = 3 * side + d
+            hn[k], ht[k] = row[C_LINEAR_N + k], row[C_LINEAR_T + k]
+            if body >= 0:
+                gap += hn[k] * q[3 * body + d]
+    return gap, 0.0, 0.0
+
+
+@jitable
 def obstacle_velocity(nx, ny, tx, ty, wx, wy, surface):
     """(w_N, w_T): an obstacle's velocity w (a driven obstacle's) along the contact's normal n and
     tangent t, plus a belt's surface velocity along t — what the relative velocity subtracts from
@@ -328,4 +348,6 @@ def kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht):
         return _vertex_on_edge(row, body_a, body_b, q, v, hn, ht)
     if kind == KIND_FIXED_VERTEX_ON_EDGE:
         return _vertex_on_edge(row, -1, body_a, q, v, hn, ht)
+    if kind == KIND_LINEAR:
+        return _linear_relation(row, body_a, body_b, q, hn, ht)
     return _disk_on_disk(row, body_a, body_b, q, v, hn, ht)

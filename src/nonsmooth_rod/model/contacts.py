@@ -30,7 +30,8 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_
                               C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_DEPTH_LIMIT, C_TIE_WINS, KIND_VERTEX_ON_EDGE,
                               KIND_FIXED_VERTEX_ON_EDGE, C_OBSTACLE_VX, C_OBSTACLE_VY,
                               C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, obstacle_velocity, C_PREV_NX,
-                              C_PREV_NY, C_NEXT_NX, C_NEXT_NY)
+                              C_PREV_NY, C_NEXT_NX, C_NEXT_NY, C_LINEAR_GAP0, C_LINEAR_N, C_LINEAR_T,
+                              KIND_LINEAR)
 from .motion import require_motion
 from .laws import ContactLaw
 
@@ -470,6 +471,69 @@ class VertexOnEdge(_PackedRelation):
         return KIND_FIXED_VERTEX_ON_EDGE, self.edge_body, -1
 
 
+def check_linear_row(key: str, row) -> dict:
+    """A linear relation's row {body: (x, y, θ coefficients)}, checked: body indices, 3 numbers each."""
+    if row is None:
+        return {}
+    if not isinstance(row, dict):
+        raise InputError(f"{key} must map body indices to (x, y, θ) coefficients, got {type(row).__name__}")
+    out = {}
+    for body, coefficients in row.items():
+        body = require_index(f"{key} body", body)
+        if isinstance(coefficients, (str, bytes)) or not hasattr(coefficients, "__len__") or len(coefficients) != 3:
+            raise InputError(f"{key}[{body}] must be 3 numbers (the x, y, θ coefficients), got {coefficients!r}")
+        out[body] = tuple(require_finite(f"{key}[{body}]", c) for c in coefficients)
+    return out
+
+
+@dataclass
+class LinearRelation(_PackedRelation):
+    """A unilateral contact whose gap is affine in the coordinates (Siconos' LagrangianLinearTIR):
+    g(q) = gap0 + Σ_bodies normal[body]·(x, y, θ), with the constant tangential row `tangent`
+    (u_T = tangent·v − tangent_velocity). `normal` and `tangent` map a body index to its
+    (x, y, θ) coefficients; at most two bodies in all. The law is the same as every contact's
+    (μs, μd, restitution). E.g. a body's point at height y on the floor: normal {0: (0, 1, 0)},
+    tangent {0: (1, 0, 0)}. The published woodpecker's contacts are of this kind
+    (toys/woodpecker.py, geometry="linearised")."""
+
+    normal: dict
+    gap0: float = 0.0
+    tangent: dict | None = None
+    law: ContactLaw = field(default_factory=ContactLaw)
+    name: str = "linear"
+    tangent_velocity: float = 0.0
+
+    def __post_init__(self):
+        self.name = _contact_name(self.name)
+        key = f"contact {self.name!r}"
+        self.normal = check_linear_row(f"{key} normal", self.normal)
+        self.tangent = check_linear_row(f"{key} tangent", self.tangent)
+        self.gap0 = require_finite(f"{key} gap0", self.gap0)
+        self.tangent_velocity = require_finite(f"{key} tangent_velocity", self.tangent_velocity)
+        _require_type(f"{key} law", self.law, ContactLaw)
+        if not any(c != 0.0 for w in self.normal.values() for c in w):
+            raise InputError(f"{key} normal: the normal row is zero (the gap must depend on some coordinate)")
+        if len(self.bodies) > 2:
+            raise InputError(f"{key}: a linear relation joins at most two bodies, got {list(self.bodies)}")
+        if self.law.friction.mu_s > 0.0 and not any(c != 0.0 for w in self.tangent.values() for c in w):
+            raise InputError(f"{key} tangent: a contact with friction (mu_s > 0) needs a non-zero tangent row")
+
+    @property
+    def bodies(self) -> tuple[int, ...]:
+        return tuple(sorted(set(self.normal) | set(self.tangent)))
+
+    def fill_row(self, row) -> tuple[int, int, int]:
+        """Writes the rows into a packed row; returns (kind, body a, body b)."""
+        bodies = self.bodies
+        for side, body in enumerate(bodies):
+            for d in range(3):
+                row[C_LINEAR_N + 3 * side + d] = self.normal.get(body, (0.0, 0.0, 0.0))[d]
+                row[C_LINEAR_T + 3 * side + d] = self.tangent.get(body, (0.0, 0.0, 0.0))[d]
+        row[C_LINEAR_GAP0] = self.gap0
+        row[C_SURFACE_VELOCITY] = self.tangent_velocity
+        return KIND_LINEAR, bodies[0], bodies[1] if len(bodies) > 1 else -1
+
+
 # Every contact relation a scene can hold, by the names users write (for error messages).
 RELATION_NAMES = ("DiskOnLine", "PointOnLine", "DiskOnSegment", "PointOnSegment", "SegmentEndOnEdge", "DiskOnDisk",
-                  "VertexOnEdge")
+                  "VertexOnEdge", "LinearRelation")

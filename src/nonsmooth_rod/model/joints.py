@@ -10,6 +10,10 @@ Each joint is two equality rows C(q) = 0:
   world's without body_b) — C₀ = n·(r_a − r_b), n the line's normal — and body_a keeps the angle
   `angle` relative to body_b — C₁ = θ_a − θ_b − angle. Its multipliers are the force along n
   on body_a and the torque on body_a.
+* LinearJoint: one linear equality between the coordinates of one or two bodies, C₀ = c + w·q
+  (Siconos' LagrangianLinearTIR with an equality law; the published woodpecker's hinge,
+  linearised: toys/woodpecker.py). Its second row is zero (the step's pseudo-inverse drops it);
+  its multiplier is the generalised force along w.
 
 `pack_joints` turns them into the table the compiled Moreau–Jean loop reads; `joint_rows` (one
 kernel, compiled or interpreted) evaluates C(q) and the Jacobian J = ∂C/∂q — integrators/
@@ -25,16 +29,21 @@ import numpy as np
 from .._jit import jit
 from ..solvers._common import interpreted
 from ..validation import InputError, quoted, require_finite
+from .contacts import check_linear_row
 from .forces import _require_point, check_two_ends
 
-JOINT_PIN, JOINT_SLIDER = 0, 1
+JOINT_PIN, JOINT_SLIDER, JOINT_LINEAR = 0, 1, 2
 ROWS_PER_JOINT = 2
 # Columns of the packed joint table (one float64 row per joint: the compiled loop's model tuple
 # takes one array for every joint): geometry, then kind and bodies (small integers, exact as floats).
 J_PA_X, J_PA_Y, J_PB_X, J_PB_Y, J_AXIS_X, J_AXIS_Y, J_ANGLE, J_KIND, J_BODY_A, J_BODY_B = range(10)
 N_JOINT_COLUMNS = 10
-# What each joint's two multipliers are, by kind (trajectory.csv's column suffixes).
-REACTION_NAMES = {JOINT_PIN: ("Fx", "Fy"), JOINT_SLIDER: ("F", "M")}
+# A linear joint's coefficients of (x, y, θ) of body a, then of body b, in the six geometry
+# columns, and its constant c in J_ANGLE.
+J_LINEAR = J_PA_X
+# What each joint's multipliers are, by kind (trajectory.csv's column suffixes; a linear joint's
+# second row is zero, its multiplier not reported).
+REACTION_NAMES = {JOINT_PIN: ("Fx", "Fy"), JOINT_SLIDER: ("F", "M"), JOINT_LINEAR: ("F",)}
 
 
 @dataclass(frozen=True)
@@ -80,7 +89,35 @@ class Slider:
         object.__setattr__(self, "angle", require_finite(f"{self.name} angle", self.angle))
 
 
-JOINT_TYPES = (Pin, Slider)
+@dataclass(frozen=True)
+class LinearJoint:
+    """A linear equality between coordinates: constant + Σ row[body]·(x, y, θ) = 0, `row` mapping
+    one or two body indices to their (x, y, θ) coefficients. Its reaction F is the multiplier of
+    that row: the generalised force F·row[body] on each body."""
+
+    row: dict
+    constant: float = 0.0
+    name: str = "linear"
+
+    kind = JOINT_LINEAR
+
+    def __post_init__(self):
+        row = check_linear_row(f"{self.name} row", self.row)
+        if not 1 <= len(row) <= 2 or not any(c != 0.0 for w in row.values() for c in w):
+            raise InputError(f"{self.name} row: one or two bodies with a non-zero row, got {self.row!r}")
+        object.__setattr__(self, "row", row)
+        object.__setattr__(self, "constant", require_finite(f"{self.name} constant", self.constant))
+
+    @property
+    def body_a(self) -> int:
+        return min(self.row)
+
+    @property
+    def body_b(self) -> int | None:
+        return max(self.row) if len(self.row) == 2 else None
+
+
+JOINT_TYPES = (Pin, Slider, LinearJoint)
 
 
 def pack_joints(joints, n_bodies: int) -> np.ndarray:
@@ -89,10 +126,15 @@ def pack_joints(joints, n_bodies: int) -> np.ndarray:
     table = np.zeros((len(joints), N_JOINT_COLUMNS))
     for i, joint in enumerate(joints):
         if not isinstance(joint, JOINT_TYPES):
-            raise InputError(f"joints[{i}] must be a Pin or a Slider, got {type(joint).__name__}")
+            raise InputError(f"joints[{i}] must be a Pin, a Slider or a LinearJoint, got {type(joint).__name__}")
         if max(joint.body_a, -1 if joint.body_b is None else joint.body_b) >= n_bodies:
             raise InputError(f"joint {joint.name!r}: body index beyond the scene's {n_bodies} bodies")
         table[i, [J_KIND, J_BODY_A, J_BODY_B]] = joint.kind, joint.body_a, -1 if joint.body_b is None else joint.body_b
+        if isinstance(joint, LinearJoint):
+            for side, body in enumerate(sorted(joint.row)):
+                table[i, J_LINEAR + 3 * side:J_LINEAR + 3 * side + 3] = joint.row[body]
+            table[i, J_ANGLE] = joint.constant
+            continue
         table[i, [J_PA_X, J_PA_Y]], table[i, [J_PB_X, J_PB_Y]] = joint.point_a, joint.point_b
         if isinstance(joint, Slider):
             table[i, [J_AXIS_X, J_AXIS_Y]], table[i, J_ANGLE] = joint.axis, joint.angle
@@ -176,6 +218,19 @@ def _slider_rows(row, a, b, q, J, r):
 
 
 @jit
+def check_linear_rows(row, a, b, q, J, r):
+    """c + w·q and its constant row; the joint's second row stays zero."""
+    c = row[J_ANGLE]
+    for side in range(2):
+        body = a if side == 0 else b
+        if body >= 0:
+            for d in range(3):
+                J[r, 3 * body + d] = row[J_LINEAR + 3 * side + d]
+                c += row[J_LINEAR + 3 * side + d] * q[3 * body + d]
+    return c, 0.0
+
+
+@jit
 def joint_rows(table, q, J, C):
     """C(q) (2 rows per joint) and its Jacobian J = ∂C/∂q (dense: rows × n_dof, overwritten)."""
     J[:, :] = 0.0
@@ -183,12 +238,16 @@ def joint_rows(table, q, J, C):
         r = ROWS_PER_JOINT * i
         row = table[i]
         a, b = int(row[J_BODY_A]), int(row[J_BODY_B])
-        if int(row[J_KIND]) == JOINT_PIN:
+        kind = int(row[J_KIND])
+        if kind == JOINT_PIN:
             c0, c1 = _pin_rows(row, a, b, q, J, r)
+        elif kind == JOINT_LINEAR:
+            c0, c1 = check_linear_rows(row, a, b, q, J, r)
         else:
             c0, c1 = _slider_rows(row, a, b, q, J, r)
         C[r], C[r + 1] = c0, c1
 
 
-__all__ = ["Pin", "Slider", "JOINT_TYPES", "pack_joints", "jointed_dofs", "joint_violation", "joint_rows",
+__all__ = ["Pin", "Slider", "LinearJoint", "JOINT_LINEAR",
+           "JOINT_TYPES", "pack_joints", "jointed_dofs", "joint_violation", "joint_rows",
            "JOINT_PIN", "JOINT_SLIDER", "REACTION_NAMES", "ROWS_PER_JOINT"]

@@ -111,13 +111,13 @@ class Scene:
         return names + [f"body {self.bodies[d.body].name!r}" for d in self.driven]
 
     def _check_joints(self) -> None:
-        """Joints are Pin or Slider on bodies that exist, with unique names."""
+        """Joints are Pin, Slider or LinearJoint on bodies that exist, with unique names."""
         from .joints import JOINT_TYPES
 
         seen = set()
         for i, joint in enumerate(self.joints):
             if not isinstance(joint, JOINT_TYPES):
-                raise InputError(f"joints[{i}] must be a Pin or a Slider, got {type(joint).__name__}")
+                raise InputError(f"joints[{i}] must be a Pin, a Slider or a LinearJoint, got {type(joint).__name__}")
             require_name(f"joints[{i}] name", joint.name)
             if joint.name in seen:
                 raise InputError(f"two joints are named {joint.name!r}: joint names must be unique")

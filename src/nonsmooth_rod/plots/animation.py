@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path
-from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, SegmentEndOnEdge, VertexOnEdge
+from ..model.contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, LinearRelation, SegmentEndOnEdge, VertexOnEdge
 from ..model.joints import Pin
 from ..validation import InputError
 
@@ -86,6 +86,8 @@ def joint_points(scene, body: int) -> list:
     """(kind, point) in `body`'s frame of every joint it takes part in: ("pin" | "slider", (x, y))."""
     points = []
     for joint in getattr(scene, "joints", ()):
+        if not hasattr(joint, "point_a"):  # a LinearJoint: no point to draw
+            continue
         kind = "pin" if isinstance(joint, Pin) else "slider"
         if joint.body_a == body:
             points.append((kind, tuple(joint.point_a)))
@@ -240,6 +242,10 @@ def contact_frames(scene, q: np.ndarray) -> list[tuple]:
                 out.append((np.array(c.segment.a if c.end == "a" else c.segment.b), n, t))
             else:
                 out.append((_world(q, j, c.offset) - c.radius * n, n, t))
+        elif isinstance(c, LinearRelation):  # no contact point: its first body's centre, its (x, y) rows
+            j = c.bodies[0]
+            rows = (c.normal.get(j, (0.0, 0.0, 0.0)), c.tangent.get(j, (0.0, 0.0, 0.0)))
+            out.append((np.array(q[3 * j: 3 * j + 2], dtype=float), *(np.array(r[:2]) for r in rows)))
         else:
             centre = _world(q, 3 * c.body, c.offset)
             n, t = np.array(c.line.normal), np.array(c.line.tangent)

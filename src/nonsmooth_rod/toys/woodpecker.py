@@ -31,6 +31,14 @@ l_G cos φ_S are 12 % below the linearised ones there, and the sleeve jams at 0.
 of (r_M − r_O)/h_M = 0.1034 rad. The limit cycle's period is 11 % shorter and the sleeve never
 reaches its upper jam after the beak's impact (docs/joints.md, "Glocker's woodpecker toy";
 `toys.woodpecker_reduced` integrates both three-coordinate models independently).
+
+`geometry="linearised"` builds the published model itself from the engine's parts: the same
+sleeve, carriage, slider and axle, but the hinge is a `LinearJoint` holding the bird's height at
+its linearised value y + l_M φ_M + l_G φ_S (the bird's horizontal position stays put: nothing
+pushes it sideways — the published mass matrix leaves its horizontal motion out), and the three
+contacts are `LinearRelation`s with the published constant rows (Siconos' WoodPecker.cpp: gaps
+l_M + l_G − l_S − r_O − h_S φ_S, r_M − r_O ± h_M φ_M; tangent rows (1, l_M, l_G − l_S), (1, r_M, 0)
+over (y, φ_M, φ_S)). It starts from the published `start`, its sleeve on the linearised jam.
 """
 from __future__ import annotations
 
@@ -40,9 +48,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.body import RigidBody
-from ..model.contacts import Line, PointOnLine
+from ..model.contacts import LinearRelation, Line, PointOnLine
 from ..model.forces import TorsionSpring
-from ..model.joints import Pin, Slider
+from ..model.joints import LinearJoint, Pin, Slider
 from ..model.laws import ContactLaw
 from ..model.scene import Scene
 from ..results import SimulationResult
@@ -51,6 +59,7 @@ from .common import G
 
 SLEEVE, CARRIAGE, BIRD = 0, 1, 2
 CONTACTS = ("beak", "lower", "upper")  # the published model's contacts 1, 2, 3
+GEOMETRIES = ("exact", "linearised")
 
 
 @dataclass(frozen=True)
@@ -58,7 +67,8 @@ class Woodpecker:
     """Glocker's woodpecker toy with the published parameters (SI units, angles in radians).
 
     `start` is the published initial state (y, φ_M, φ_S, ẏ, φ̇_M, φ̇_S): the sleeve jammed on its
-    lower edge, sliding down, the bird swinging back (Siconos' WoodPeckerConsts.h)."""
+    lower edge, sliding down, the bird swinging back (Siconos' WoodPeckerConsts.h). `geometry`:
+    "exact" (the planar toy) or "linearised" (the published model: the module's notes)."""
 
     pole_radius: float = 0.0025  # r_O
     sleeve_radius: float = 0.0031  # r_M: the sleeve's inner radius
@@ -77,8 +87,11 @@ class Woodpecker:
     sleeve_restitution: float = 0.0
     g: float = G
     start: tuple = (0.0, -0.1036, -0.2788, -0.3411, 0.0, -7.4583)
+    geometry: str = "exact"
 
     def __post_init__(self):
+        if self.geometry not in GEOMETRIES:
+            raise InputError(f"geometry must be one of {', '.join(GEOMETRIES)}, got {self.geometry!r}")
         for name in ("pole_radius", "sleeve_half_height", "hinge_offset", "bird_offset", "beak_height",
                      "sleeve_mass", "bird_mass", "sleeve_inertia", "bird_inertia", "spring_stiffness", "g"):
             require_positive(name, getattr(self, name))
@@ -93,7 +106,8 @@ class Woodpecker:
     @property
     def jam_angle(self) -> float:
         """|φ_M| at which an inner edge of the sleeve touches the pole (exact geometry):
-        r_M cos φ − h_M sin|φ| = r_O, i.e. R cos(|φ| + α) = r_O with R = |(r_M, h_M)|."""
+        r_M cos φ − h_M sin|φ| = r_O, i.e. R cos(|φ| + α) = r_O with R = |(r_M, h_M)| (the
+        linearised model's: (r_M − r_O)/h_M)."""
         r, h = self.sleeve_radius, self.sleeve_half_height
         return math.acos(self.pole_radius / math.hypot(r, h)) - math.atan2(h, r)
 
@@ -102,22 +116,45 @@ class Woodpecker:
         bodies = [RigidBody(half, self.sleeve_inertia, name="sleeve"),
                   RigidBody(half, self.sleeve_inertia, name="carriage"),
                   RigidBody(self.bird_mass, self.bird_inertia, name="bird")]
-        pole = Line((self.pole_radius, 0.0), -math.pi / 2)  # the face x = r_O, normal +x
-        sleeve_law = ContactLaw.of(self.mu, self.mu, self.sleeve_restitution)
-        r, h = self.sleeve_radius, self.sleeve_half_height
-        contacts = [PointOnLine(BIRD, (-self.beak_back, self.beak_height), pole,
-                                ContactLaw.of(self.mu, self.mu, self.beak_restitution), name="beak"),
-                    PointOnLine(SLEEVE, (r, -h), pole, sleeve_law, name="lower"),
-                    PointOnLine(SLEEVE, (r, h), pole, sleeve_law, name="upper")]
+        laws = (ContactLaw.of(self.mu, self.mu, self.beak_restitution),
+                ContactLaw.of(self.mu, self.mu, self.sleeve_restitution))
+        linear = self.geometry == "linearised"
+        contacts, hinge = self._linearised_parts(*laws) if linear else self._exact_parts(*laws)
         joints = [Slider(CARRIAGE, (0.0, 0.0), None, (0.0, 0.0), (0.0, 1.0), 0.0, name="guide"),
-                  Pin(SLEEVE, (0.0, 0.0), CARRIAGE, (0.0, 0.0), name="axle"),
-                  Pin(SLEEVE, (self.hinge_offset, 0.0), BIRD, (-self.bird_offset, 0.0), name="hinge")]
+                  Pin(SLEEVE, (0.0, 0.0), CARRIAGE, (0.0, 0.0), name="axle"), hinge]
         spring = TorsionSpring(BIRD, SLEEVE, self.spring_stiffness, 0.0, name="spring")
         return Scene(bodies, contacts, gravity=self.g, joints=joints, forces=[spring])
+
+    def _exact_parts(self, beak_law, sleeve_law):
+        """The contacts on the pole's face and the hinge's pin, exact geometry."""
+        pole = Line((self.pole_radius, 0.0), -math.pi / 2)  # the face x = r_O, normal +x
+        r, h = self.sleeve_radius, self.sleeve_half_height
+        contacts = [PointOnLine(BIRD, (-self.beak_back, self.beak_height), pole, beak_law, name="beak"),
+                    PointOnLine(SLEEVE, (r, -h), pole, sleeve_law, name="lower"),
+                    PointOnLine(SLEEVE, (r, h), pole, sleeve_law, name="upper")]
+        return contacts, Pin(SLEEVE, (self.hinge_offset, 0.0), BIRD, (-self.bird_offset, 0.0), name="hinge")
+
+    def _linearised_parts(self, beak_law, sleeve_law):
+        """The published constant contact rows over (y, φ_M, φ_S) = the sleeve's y and θ, the bird's θ
+        (Siconos' WoodPecker.cpp), and the hinge linearised: y_bird = y + l_M φ_M + l_G φ_S."""
+        lm, lg, ls, hs = self.hinge_offset, self.bird_offset, self.beak_back, self.beak_height
+        clearance, hm, r = self.sleeve_radius - self.pole_radius, self.sleeve_half_height, self.sleeve_radius
+        contacts = [LinearRelation({BIRD: (0.0, 0.0, -hs)}, lm + lg - ls - self.pole_radius,
+                                   {SLEEVE: (0.0, 1.0, lm), BIRD: (0.0, 0.0, lg - ls)}, beak_law, name="beak"),
+                    LinearRelation({SLEEVE: (0.0, 0.0, hm)}, clearance, {SLEEVE: (0.0, 1.0, r)}, sleeve_law,
+                                   name="lower"),
+                    LinearRelation({SLEEVE: (0.0, 0.0, -hm)}, clearance, {SLEEVE: (0.0, 1.0, r)}, sleeve_law,
+                                   name="upper")]
+        hinge = LinearJoint({BIRD: (0.0, 1.0, -lg), SLEEVE: (0.0, -1.0, -lm)}, 0.0, name="hinge")
+        return contacts, hinge
 
     def state_of(self, y, phi_m, phi_s, dy, omega_m, omega_s):
         """(q, v) of the three bodies for the model's coordinates (y, φ_M, φ_S) and their rates."""
         lm, lg = self.hinge_offset, self.bird_offset
+        if self.geometry == "linearised":  # the bird's centre only moves up and down, linearly
+            q = np.array([0.0, y, phi_m, 0.0, y, 0.0, lm + lg, y + lm * phi_m + lg * phi_s, phi_s])
+            v = np.array([0.0, dy, omega_m, 0.0, dy, 0.0, 0.0, dy + lm * omega_m + lg * omega_s, omega_s])
+            return q, v
         bird = (lm * math.cos(phi_m) + lg * math.cos(phi_s), y + lm * math.sin(phi_m) + lg * math.sin(phi_s))
         bird_v = (-lm * math.sin(phi_m) * omega_m - lg * math.sin(phi_s) * omega_s,
                   dy + lm * math.cos(phi_m) * omega_m + lg * math.cos(phi_s) * omega_s)
@@ -133,8 +170,17 @@ class Woodpecker:
         y, phi_m, *rest = self.start
         return (y, max(phi_m, -self.jam_angle), *rest)
 
+    @property
+    def linearised_start(self) -> tuple:
+        """`start` with the sleeve's angle on the linearised jam −(r_M − r_O)/h_M = −0.103448 rad: the
+        published −0.1036 sinks the lower edge 0.9 µm into the pole, more than a scene file's
+        initial overlap tolerance."""
+        y, phi_m, *rest = self.start
+        return (y, max(phi_m, -(self.sleeve_radius - self.pole_radius) / self.sleeve_half_height), *rest)
+
     def initial_state(self):
-        return self.state_of(*self.exact_start)
+        """`linearised_start` or `exact_start`, by the geometry."""
+        return self.state_of(*(self.linearised_start if self.geometry == "linearised" else self.exact_start))
 
     @staticmethod
     def coordinates(result: SimulationResult) -> np.ndarray:
