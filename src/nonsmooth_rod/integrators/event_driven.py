@@ -59,7 +59,7 @@ from ..validation import (
     require_positive,
     require_state,
 )
-from ..solvers import available_solvers
+from ..solvers.registry import SolverName
 from . import check_output_size
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -86,7 +86,7 @@ class EventDrivenOptions:
     max_events: int = option(10_000, Integer(1, 10**9))
     # impacts closer than this in time: an accumulation point (s)
     zeno_interval: float = option(1e-9, Number(0.0, 1e-3))
-    impact_solver: str = option("enum", Choice(available_solvers))
+    impact_solver: str = option("enum", SolverName())  # the exact reference for the few contacts of an impact
     gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
     velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
 

@@ -5,6 +5,8 @@ the friction interval [lo_i p_N, hi_i p_N] of `problem.PlanarFrictionProblem`::
 
     solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter) -> (status, iterations, residual)
 
+(`solve_interval_into`: the same in a caller's scratch; the codes are registry.SOLVERS')
+
 fills p and u = W p + q in place (p is also pgs's warm start) and returns a status code,
 the solver's iterations (Lemke pivots, pgs sweeps, enum combinations) and the common
 complementarity residual. ``rtol`` is the tolerance on that residual relative to the
@@ -37,6 +39,7 @@ from .kernel_base import (
     KERNEL_RAY,
     KERNEL_SOLVED,
     KERNEL_TOO_LARGE,
+    BLOCK_SPARSE_CODES,
     SOLVER_CODES,
     SOLVER_ENUM,
     SOLVER_LEMKE,
@@ -50,6 +53,7 @@ from .kernel_base import (
     problem_scale,
     solver_scratch,
     step_residual,
+    takes_block_sparse,
 )
 
 
@@ -101,27 +105,20 @@ def _screened(status):
     return status, 0, (np.inf if status == KERNEL_NONFINITE else 0.0)
 
 
-# One entry per solver: a loop specialised to one solver compiles only that one (issue 16).
-@jit
-def solve_lemke(W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval with SOLVER_LEMKE."""
-    floats, ints = solver_scratch(lo.shape[0])
-    return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
-
-
 @jit
 def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-    """solve_lemke in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0]
-    contacts): what the Moreau–Jean loop calls, allocating nothing per step."""
+    """lemke_interval behind the common screen, in the scratch (floats, ints), or in scratch of
+    its own when they are too small for these contacts (kernel_base.fitting_scratch)."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
+    floats, ints = fitting_scratch(floats, ints, lo.shape[0])
     return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
 @jit
 def solve_pgs(W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval with SOLVER_PGS."""
+    """pgs_dense behind the common screen."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
@@ -130,7 +127,7 @@ def solve_pgs(W, q, lo, hi, p, u, rtol, max_iter):
 
 @jit
 def solve_enum(W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval with SOLVER_ENUM (max_iter has no meaning for enum)."""
+    """enum_interval behind the common screen (max_iter has no meaning for enum)."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
@@ -138,13 +135,14 @@ def solve_enum(W, q, lo, hi, p, u, rtol, max_iter):
 
 
 @jit
-def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
-    """Solve the dense step problem with solver SOLVER_LEMKE | SOLVER_PGS | SOLVER_ENUM.
-
-    Fills p, u in place; returns (status, iterations, residual) (module docstring).
-    """
+def solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+    """The compiled dispatch: the dense step problem solved by the solver of code `solver_code`
+    (registry.SOLVERS), Lemke in the scratch (floats, ints). One branch per compiled solver of
+    the table — numba calls a kernel by its name, not out of a table; the loop reads the code at
+    run time, so every solver compiles into the one loop. Fills p, u in place; returns (status,
+    iterations, residual) (module docstring)."""
     if solver_code == SOLVER_LEMKE:
-        return solve_lemke(W, q, lo, hi, p, u, rtol, max_iter)
+        return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     if solver_code == SOLVER_PGS:
         return solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
     if solver_code == SOLVER_ENUM:
@@ -154,8 +152,15 @@ def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
     return KERNEL_NO_CONVERGENCE, 0, np.inf
 
 
+@jit
+def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval_into with scratch of its own (allocated by the solver that needs it)."""
+    floats, ints = solver_scratch(0)
+    return solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
+
+
 __all__ = [
     "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
-    "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
-    "solve_interval", "solve_lemke", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
+    "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "BLOCK_SPARSE_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
+    "solve_interval", "solve_interval_into", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite", "takes_block_sparse",
 ]
