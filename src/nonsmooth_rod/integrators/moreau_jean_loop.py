@@ -337,7 +337,7 @@ def _contacts_by_body(na, active, index, start, fill, members):
 
 @jit
 def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
-    """The block-sparse Delassus matrix over the active contacts (solvers.kernels' CSR layout:
+    """The block-sparse Delassus matrix over the active contacts (solvers/delassus.py's block layout:
     indptr, indices, 2×2 blocks): a block for each pair of contacts sharing a body, so building
     it costs O(active contacts × contacts per body), not O(contacts²). Carved from the scratch
     (ints, floats: S_SPARSE_INTS, S_SPARSE_FLOATS, sized by step_scratch for any active set). The

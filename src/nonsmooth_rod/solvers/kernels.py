@@ -17,7 +17,7 @@ enum accept DEFAULT_RTOL; pgs aims for PGS_RTOL and accepts DEFAULT_RTOL once it
 On any status but KERNEL_SOLVED, p = 0 and u = q (pgs leaves its last iterate).
 
 Large scenes: `pgs_block` on the block-sparse Delassus (indptr, indices, blocks; see
-`gauss_seidel.dense_to_blocks`) costs O(nonzero blocks) per sweep.
+`delassus.py`) costs O(nonzero blocks) per sweep.
 
 Every function here is decorated with `nonsmooth_rod._jit.jit`: numba-compiled when numba is
 installed, the same source interpreted otherwise. Float64 arrays, int64 scalars only.
@@ -29,7 +29,8 @@ import numpy as np
 
 from .._jit import jit
 from .enumeration import enum_interval
-from .gauss_seidel import dense_to_blocks, pgs_block, pgs_dense
+from .delassus import dense_to_blocks
+from .gauss_seidel import pgs_block, pgs_dense
 from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into
 
 from .kernel_base import (

@@ -33,7 +33,8 @@ from ._common import interpreted
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
                       PlanarFrictionProblem, SolverError)
 from .registry import DEFAULT_SOLVER
-from .sticking import coupled_components, gather_contacts, group_matrix, prefer_sticking_by_group, scatter_contacts
+from .delassus import coupled_components, group_matrix
+from .sticking import gather_contacts, prefer_sticking_by_group, scatter_contacts
 
 STATE_NAMES = CONTACT_STATES  # (the codes' names, problem.py)
 # What the sign iteration does after a solve that was not consistent.
