@@ -40,7 +40,6 @@ class SolverSpec:
     # other scalar settings pass through by name (a QP backend's own, which the backend checks)
     backend_settings: bool = False
     entry: str = ""  # "module:function" that `solvers.solve` runs on a PlanarFrictionProblem
-    summary: str = ""
     block_sparse: bool = False  # the compiled loop hands it the block-sparse W (pgs), not the dense one
     extra: str | None = None  # the optional extra that installs it (pip install nonsmooth-rod[qp])
     probe: str | None = None  # "module:function" listing the installed backends (cached there)
@@ -48,27 +47,27 @@ class SolverSpec:
 
 
 SOLVERS = (
-    SolverSpec("lemke", 0, EXACT, {"tol": _TOL, "max_iter": Integer(1, 10**9)}, entry="lemke:lemke_friction",
-               summary="Lemke's method on the exact lifted LCP"),
+    # Lemke's method on the exact lifted LCP
+    SolverSpec("lemke", 0, EXACT, {"tol": _TOL, "max_iter": Integer(1, 10**9)}, entry="lemke:lemke_friction"),
+    # nonsmooth Gauss–Seidel with exact 2×2 contact solves, on the block-sparse W
     SolverSpec("pgs", 1, EXACT, {"tol": _TOL, "max_iter": Integer(1, 10**9)},
-               entry="gauss_seidel:projected_gauss_seidel", block_sparse=True,
-               summary="nonsmooth Gauss–Seidel with exact 2×2 contact solves"),
-    SolverSpec("enum", 2, EXACT, {"tol": _TOL}, entry="enumeration:enumerate_modes",
-               summary="enumeration of all contact-mode combinations (≤ 4 contacts a group)"),
+               entry="gauss_seidel:projected_gauss_seidel", block_sparse=True),
+    # enumeration of all contact-mode combinations (≤ 4 contacts a group)
+    SolverSpec("enum", 2, EXACT, {"tol": _TOL}, entry="enumeration:enumerate_modes"),
+    # per installed backend: Tresca fixed point of QPs through qpsolvers (e.g. osqp, clarabel)
     SolverSpec("{backend}", None, QP, {"tol": _TOL, "max_iter": Integer(1, 10**6), "check_tol": _TOL},
-               backend_settings=True, entry="qp:tresca_fixed_point", extra="qp", probe="qp:installed_backends",
-               summary="Tresca fixed point of QPs through qpsolvers (e.g. osqp, clarabel)"),
+               backend_settings=True, entry="qp:tresca_fixed_point", extra="qp", probe="qp:installed_backends"),
+    # per installed backend: the convex relaxation, one QP (has the sliding-separation artefact)
     SolverSpec("{backend}-relaxed", None, QP, {"check_tol": _TOL}, backend_settings=True,
-               entry="qp:relaxed_qp", extra="qp", probe="qp:installed_backends",
-               summary="convex relaxation, one QP (has the sliding-separation artefact)"),
+               entry="qp:relaxed_qp", extra="qp", probe="qp:installed_backends"),
 )
 
 DEFAULT_SOLVER = SOLVERS[0].name
 EXACT_SOLVERS = tuple(s.name for s in SOLVERS if s.probe is None)  # always there, in table order
 SOLVER_CODES = {s.name: s.code for s in SOLVERS if s.code is not None}  # name -> compiled code
 _BY_CODE = sorted((s for s in SOLVERS if s.code is not None), key=lambda s: s.code)
-# codes are the positions 0, 1, ... so that the compiled loop can index per-code facts
-assert [s.code for s in _BY_CODE] == list(range(len(_BY_CODE))), "solver codes must be 0, 1, ..."
+if [s.code for s in _BY_CODE] != list(range(len(_BY_CODE))):  # the compiled loop indexes per-code facts
+    raise ValueError(f"solver codes must be 0, 1, ... in the table, got {[s.code for s in _BY_CODE]}")
 BLOCK_SPARSE_CODES = tuple(bool(s.block_sparse) for s in _BY_CODE)  # per code: takes the block-sparse W
 
 
@@ -167,5 +166,5 @@ def solver_function(row: SolverSpec):
 
 
 __all__ = ["SolverSpec", "SOLVERS", "EXACT", "QP", "DEFAULT_SOLVER", "EXACT_SOLVERS", "SOLVER_CODES",
-           "BLOCK_SPARSE_CODES", "SOLVER_HELP", "spec", "installed", "available_solvers", "find_solver", "require_solver",
-           "SolverName", "check_solver_options", "solver_function"]
+           "BLOCK_SPARSE_CODES", "SOLVER_HELP", "spec", "installed", "available_solvers", "find_solver",
+           "require_solver", "SolverName", "check_solver_options", "solver_function"]

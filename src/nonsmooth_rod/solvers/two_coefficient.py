@@ -359,4 +359,4 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
 
 __all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_into", "two_coefficient_by_group", "StepContactResult",
            "classify_solution",
-           "next_action", "solve_interval", "SolverError", "STATE_NAMES"]
+           "next_action", "SolverError", "STATE_NAMES"]
