@@ -11,7 +11,7 @@ the same kind of Python loop.
 
 Scaling: N balls in a row on a floor, each touching the floor and its neighbours (2N − 1
 contacts), falling and sliding (random horizontal velocities, μ = 0.3); the Delassus matrix
-is block-sparse (`gauss_seidel.dense_to_blocks` format, built in O(N)). Reported: µs per
+is block-sparse (`delassus.py` block layout, built in O(N)). Reported: µs per
 `pgs_block` sweep (sweep + u + residual), that per contact, and the ratio to the yardstick.
 Before the kernels, pgs ran in Python over a dense W: 2.4 s per sweep at 2020 contacts.
 `--quick` runs a few problems, one repeat and rows of up to 199 contacts (for the test).

@@ -12,6 +12,8 @@ import os
 import sys
 import time
 
+from .solvers.registry import DEFAULT_SOLVER
+
 
 def _tiny_scene():
     """Two balls on a floor touching each other: every contact kind the loop packs."""
@@ -28,7 +30,7 @@ def _tiny_scene():
     return Scene(balls, contacts)
 
 
-def warm_up(solvers=("lemke",)) -> float:
+def warm_up(solvers=(DEFAULT_SOLVER,)) -> float:
     """Compile the loop by running a tiny scene with each solver (the first compiles, the others
     load or are already there); returns the seconds it took."""
     previous = os.environ.get("NONSMOOTH_ROD_COMPILE")

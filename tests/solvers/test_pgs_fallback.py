@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
-from nonsmooth_rod.solvers.gauss_seidel import dense_to_blocks
+from nonsmooth_rod.solvers.delassus import dense_to_blocks
 from nonsmooth_rod.solvers.kernels import KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, pgs_block
 from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity_residual, residual_scale
 from nonsmooth_rod.solvers.two_coefficient import pgs_or_lemke

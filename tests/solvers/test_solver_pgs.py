@@ -6,7 +6,8 @@ import pytest
 from hypothesis import given, settings
 
 from nonsmooth_rod.solvers import solve
-from nonsmooth_rod.solvers.gauss_seidel import dense_to_blocks, pgs_sweep, projected_gauss_seidel, solve_contact
+from nonsmooth_rod.solvers.delassus import dense_to_blocks
+from nonsmooth_rod.solvers.gauss_seidel import pgs_sweep, projected_gauss_seidel, solve_contact
 from nonsmooth_rod.solvers.problem import (
     NoConvergence,
     PlanarFrictionProblem,

@@ -168,8 +168,8 @@ def _two_wedged_rods():
 
 @pytest.mark.parametrize("compiled", [True, False])
 def test_coupled_components_dense_and_block_sparse(compiled):
-    from nonsmooth_rod.solvers.gauss_seidel import dense_to_blocks
-    from nonsmooth_rod.solvers.sticking import coupled_components
+    from nonsmooth_rod.solvers.delassus import dense_to_blocks
+    from nonsmooth_rod.solvers.delassus import coupled_components
 
     label_of = coupled_components if compiled else _interpreted(coupled_components)
     rng = np.random.default_rng(3)

@@ -4,6 +4,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ..solvers.registry import DEFAULT_SOLVER, SOLVER_HELP, require_solver
 from ..validation import InputError
 from .options import (
     EXIT_OK,
@@ -34,7 +35,7 @@ def register(subparsers) -> None:
     num.add_argument("--tol", type=number, default=None,
                      help="Moreau–Jean error control: step sizes chosen for this tolerance on positions (m, rad) "
                           "and on located event times (s); docs/error_control.md")
-    num.add_argument("--solver", default="lemke", help="Moreau–Jean one-step solver (default lemke)")
+    num.add_argument("--solver", default=DEFAULT_SOLVER, help=SOLVER_HELP)
     num.add_argument("--theta", type=number, default=0.5, help="Moreau–Jean θ in [0.5, 1] (default 0.5)")
     num.add_argument("--min-phase", type=number, default=None,
                      help="Moreau–Jean: merge phases shorter than this, s (default 2h)")
@@ -68,10 +69,7 @@ def _check_numerics(args) -> None:
     if args.ode_method is not None and args.ode_method not in ODE_METHODS + ("rk4",):
         raise InputError(f"--ode-method must be one of {', '.join(ODE_METHODS + ('rk4',))}, got {args.ode_method!r}")
     if args.method == "moreau-jean":
-        from ..solvers import available_solvers
-
-        if args.solver not in available_solvers():
-            raise InputError(f"unknown solver '{args.solver}'; choose from: {', '.join(available_solvers())}")
+        require_solver("--solver", args.solver)
 
 
 def _print_report(run, out_dir: Path, console) -> None:

@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 
+from ..solvers.registry import DEFAULT_SOLVER, SOLVER_HELP, require_solver
 from ..validation import InputError
 
 DESCRIPTION = """\
@@ -30,7 +31,8 @@ sequence, status, held, each contact's first slip/stick/lift-off/impact time, th
 map.parquet, sweep.json, map.png (regimes over --map-axes) and, with --refine K, boundaries.csv
 (each regime boundary bisected K times between neighbouring grid points). See docs/sweeps.md."""
 
-ROD_DEFAULTS = {"mu_s": "0.05:0.5:46", "theta0_deg": "60", "method": "moreau-jean", "h": 2e-3, "solver": "lemke",
+ROD_DEFAULTS = {"mu_s": "0.05:0.5:46", "theta0_deg": "60", "method": "moreau-jean", "h": 2e-3,
+                "solver": DEFAULT_SOLVER,
                 "check": 8, "g": 9.81}
 
 RANGE_AXES = (("ball-radius", "ball radius r, m (default 0.020)"),
@@ -71,7 +73,7 @@ def register(subparsers) -> None:
     num.add_argument("--method", default=None, help="moreau-jean (default) or event-driven")
     num.add_argument("--h", type=_float, default=None,
                      help="Moreau-Jean step size, s (default 2e-3: times within 3h = 6 ms of the reference)")
-    num.add_argument("--solver", default=None, help="Moreau-Jean one-step solver (default lemke)")
+    num.add_argument("--solver", default=None, help=SOLVER_HELP)
     num.add_argument("--check", type=_int, default=None,
                      help="points re-run with the event-driven reference to report the accuracy (default 8)")
     num.add_argument("--executor", default="local", help="local (a process pool, default) or dask")
@@ -126,9 +128,7 @@ def _check_numerics(args) -> int:
         known = METHODS if args.method not in METHODS else ("moreau-jean", "event-driven")
         raise InputError(f"unknown method '{args.method}' for a sweep; choose from: {', '.join(known)}")
     if args.method == "moreau-jean":
-        from ..solvers import available_solvers
-        if args.solver not in available_solvers():
-            raise InputError(f"unknown solver '{args.solver}'; choose from: {', '.join(available_solvers())}")
+        require_solver("--solver", args.solver)
         if not 0 < args.h <= 1e-2:
             raise InputError(f"--h must lie in (0, 0.01] s, got {args.h:g}")
     if not 0 <= args.check <= 1000:

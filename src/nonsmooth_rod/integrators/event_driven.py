@@ -49,7 +49,7 @@ from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import Choice, Integer, Number, Text, check_options, option
-from ..solvers import available_solvers
+from ..solvers.registry import SolverName
 from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -76,7 +76,7 @@ class EventDrivenOptions:
     max_events: int = option(10_000, Integer(1, 10**9))
     # impacts closer than this in time: an accumulation point (s)
     zeno_interval: float = option(1e-9, Number(0.0, 1e-3))
-    impact_solver: str = option("enum", Choice(available_solvers))
+    impact_solver: str = option("enum", SolverName())  # the exact reference for the few contacts of an impact
     gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
     velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
 

@@ -30,11 +30,11 @@ from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
-from ..solvers import available_solvers, check_solver_options
+from ..solvers.registry import DEFAULT_SOLVER, EXACT_SOLVERS, SOLVER_CODES, SolverName, check_solver_options
 from ..solvers._common import interpreted
 from ..solvers.problem import SolverError
-from ..solvers.two_coefficient import COMPILED_SOLVERS, STATE_NAMES, solve_two_coefficient
-from ..validation import Choice, Flag, InputError, Number, Text, check_options, option
+from ..solvers.two_coefficient import STATE_NAMES, solve_two_coefficient
+from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
 from .joint_step import work_size
@@ -64,7 +64,7 @@ class MoreauJeanOptions:
     theta: float = option(0.5, Number(0.0, 1.0))
     # a contact enters the step when g + γ h u_N ≤ 0
     activation_gamma: float = option(0.5, Number(0.0, 1.0), label="activation_gamma")
-    solver: str = option("lemke", Choice(available_solvers))
+    solver: str = option(DEFAULT_SOLVER, SolverName())
     solver_options: dict = option(None, None, default_factory=dict)  # checked per solver below
     stop_at_impact: str | None = option(None, Text())  # name of a contact whose first impact ends the run
     min_phase: float | None = option(None, Number(0.0, optional=True))  # shorter phases are merged (default 2h)
@@ -171,7 +171,7 @@ def compiled_part(solver: str, solver_code, callback: bool):
     the compiled loop."""
     if solver_code is None:
         return "moreau-jean-python-step", "the step kernels around Python solvers", ["--python-step", solver]
-    return "moreau-jean", "the Moreau–Jean loop (lemke, pgs and enum)", []  # callbacks run it step by step
+    return "moreau-jean", f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})", []  # callbacks run it step by step
 
 
 def _python_motions(packed) -> list:
@@ -258,7 +258,7 @@ class MoreauJean:
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         params, iparams = self._parameters(scene, grid, names)
-        solver_code = COMPILED_SOLVERS.get(opts.solver)
+        solver_code = SOLVER_CODES.get(opts.solver)
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
         self._motions_in_python = _python_motions(packed)
         self._calls_back = scene.applied_force is not None or bool(self._motions_in_python)
@@ -281,7 +281,7 @@ class MoreauJean:
         model, work = _model_and_work(packed, resume)
         params, iparams = self._parameters(scene, Grid.of(self.options.h, t0, t_end, None), names)
         engine = Engine(bool(self.options.fast and _jit.ENABLED),
-                        *compiled_part(self.options.solver, COMPILED_SOLVERS.get(self.options.solver),
+                        *compiled_part(self.options.solver, SOLVER_CODES.get(self.options.solver),
                                        scene.applied_force is not None))
         self._solver_error, self._motions_in_python = None, []  # tol: no driven motions (declares)
         with _jit.one_blas_thread():
@@ -290,7 +290,7 @@ class MoreauJean:
 
     def _parameters(self, scene, grid, names):
         opts = self.options
-        solver_code = COMPILED_SOLVERS.get(opts.solver)
+        solver_code = SOLVER_CODES.get(opts.solver)
         solver_options = dict(opts.solver_options)
         params = np.zeros(loop.N_PARAMS)
         params[loop.P_H], params[loop.P_THETA], params[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma

@@ -37,8 +37,7 @@ from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
                              contact_kinematics, drive_contacts, row_dot)
-from ..solvers.kernels import (SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS, carve, carve_matrix, fitting_scratch,
-                               solver_scratch)
+from ..solvers.kernels import carve, carve_matrix, fitting_scratch, solver_scratch, takes_block_sparse
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
                          project_positions)
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
@@ -330,7 +329,7 @@ def _contacts_by_body(na, active, index, start, fill, members):
 
 @jit
 def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
-    """The block-sparse Delassus matrix over the active contacts (solvers.kernels' CSR layout:
+    """The block-sparse Delassus matrix over the active contacts (solvers/delassus.py's block layout:
     indptr, indices, 2×2 blocks): a block for each pair of contacts sharing a body, so building
     it costs O(active contacts × contacts per body), not O(contacts²). Carved from the scratch
     (ints, floats: S_SPARSE_INTS, S_SPARSE_FLOATS, sized by step_scratch for any active set). The
@@ -646,7 +645,7 @@ def _warm_start(k, na, active, was_closed, p_normal, p_tangent, p):
 def step_scratch(solver_code, model):
     """The per-run scratch (Scratch) for the packed scene `model`."""
     n_contacts, n_bodies = model.contacts.shape[0], model.minv.shape[0] // 3
-    sparse = solver_code == SOLVER_PGS
+    sparse = takes_block_sparse(solver_code)
     dense = 0 if sparse else min(n_contacts, SCRATCH_W_CONTACTS)
     blocks = _sparse_capacity(model.contact_index, n_bodies) if sparse else 0
     solver_floats, solver_ints = solver_scratch(min(n_contacts, SCRATCH_SOLVER_CONTACTS))
@@ -675,7 +674,7 @@ def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index
     Returns the kernel status. (It counts references: it may allocate, a W beyond the scratch.)"""
     m = 2 * na
     # pgs sweeps the block-sparse W; lemke, enum need it dense, and so do joints (W_c couples a cluster)
-    sparse = solver_code == SOLVER_PGS and joints.shape[0] == 0
+    sparse = takes_block_sparse(solver_code) and joints.shape[0] == 0
     W = _dense_matrix(s_w, m, sparse)
     q_step, at = carve(s_floats, 0, m)
     guess, at = carve(s_floats, at, na)

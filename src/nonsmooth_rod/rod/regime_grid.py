@@ -11,6 +11,7 @@ import numpy as np
 
 from ..studies.runner import (  # noqa: F401  (re-exported)
     KEY_DIGITS, LOCK_NAME, has_repeats, parse_range, point_key, row_key)
+from ..solvers.registry import DEFAULT_SOLVER
 from ..validation import InputError
 from .hypotheses import RollingHypothesis, rolling_hypothesis
 from .problem import RodProblem
@@ -44,7 +45,7 @@ class SweepSettings:
 
     method: str = "moreau-jean"
     h: float = 2e-3
-    solver: str = "lemke"
+    solver: str = DEFAULT_SOLVER
     rtol: float | None = None  # None: the method's own default (event-driven 1e-12)
 
     def simulate_kwargs(self) -> dict:

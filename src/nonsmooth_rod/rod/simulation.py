@@ -15,6 +15,7 @@ from .problem import RodProblem
 from ..result_files import ROD_SUMMARY_SCHEMA
 from ..results import Phase, SimulationResult
 from .hypotheses import RollingHypothesis, rolling_hypothesis
+from ..solvers.registry import DEFAULT_SOLVER
 from ..validation import InputError, require_positive
 
 METHODS = ("event-driven", "moreau-jean", "regularized", "switched", "hybrid")
@@ -95,7 +96,7 @@ def _impact_of_b(problem: RodProblem, result: SimulationResult) -> dict | None:
 
 
 def simulate(problem: RodProblem | None = None, method: str = "event-driven", *, t_end: float | None = None,
-             h: float | None = None, solver: str = "lemke", tol: float | None = None, theta: float = 0.5,
+             h: float | None = None, solver: str = DEFAULT_SOLVER, tol: float | None = None, theta: float = 0.5,
              min_phase: float | None = None,
              rtol: float | None = None, output_dt: float = 1e-3, epsilon: float = 1e-4,
              friction_curve: str = "stribeck", ode_method: str | None = None, atol: float | None = None,

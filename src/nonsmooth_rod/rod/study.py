@@ -31,6 +31,7 @@ import numpy as np
 
 from .problem import PAPER_CASES, RodProblem
 from ..results import Phase
+from ..solvers.registry import DEFAULT_SOLVER, EXACT_SOLVERS
 from ..validation import InputError
 
 REFERENCE_RTOL = 1e-12
@@ -82,12 +83,12 @@ REGULARIZED_RTOL = 1e-8  # tight enough that ε, not the tolerance, sets the reg
 
 FULL_SWEEPS = (
     Sweep("event-driven", "DOP853", "rtol", (1e-3, 1e-4, 1e-6, 1e-8, 1e-10)),
-    Sweep("moreau-jean", "lemke", "h", (1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5), (("solver", "lemke"),)),
-    Sweep("moreau-jean", "enum", "h", (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), (("solver", "enum"),)),
-    Sweep("moreau-jean", "pgs", "h", (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), (("solver", "pgs"),)),
+    # every exact solver of the table (the default one down to 1e-5 s), and one QP backend
+    *(Sweep("moreau-jean", name, "h", (1e-2, 3e-3, 1e-3, 3e-4, 1e-4) + ((3e-5, 1e-5) if name == DEFAULT_SOLVER else ()),
+            (("solver", name),)) for name in EXACT_SOLVERS),
     Sweep("moreau-jean", "osqp", "h", (1e-2, 3e-3, 1e-3, 3e-4), (("solver", "osqp"),)),
     # error control (integrators/adaptive.py): the step sizes chosen for each tolerance
-    Sweep("moreau-jean", "lemke, tol", "tol", (1e-3, 1e-4, 1e-5, 1e-6), (("solver", "lemke"),)),
+    Sweep("moreau-jean", f"{DEFAULT_SOLVER}, tol", "tol", (1e-3, 1e-4, 1e-5, 1e-6), (("solver", DEFAULT_SOLVER),)),
     *(Sweep("regularized", f"stribeck/{ode}", "epsilon", (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6),
             (("friction_curve", "stribeck"), ("ode_method", ode), ("rtol", REGULARIZED_RTOL)))
       for ode in ("RK45", "DOP853", "Radau", "BDF", "LSODA")),
@@ -100,7 +101,7 @@ FULL_SWEEPS = (
 
 QUICK_SWEEPS = (
     Sweep("event-driven", "DOP853", "rtol", (1e-4, 1e-8)),
-    Sweep("moreau-jean", "lemke", "h", (1e-2, 1e-3), (("solver", "lemke"),)),
+    Sweep("moreau-jean", DEFAULT_SOLVER, "h", (1e-2, 1e-3), (("solver", DEFAULT_SOLVER),)),
     Sweep("regularized", "stribeck/LSODA", "epsilon", (1e-3, 1e-5),
           (("friction_curve", "stribeck"), ("ode_method", "LSODA"), ("rtol", REGULARIZED_RTOL))),
     Sweep("switched", "rk4", "h", (1e-3,), (("ode_method", "rk4"),)),
@@ -310,7 +311,7 @@ def _warm_up(specs) -> None:
     it from numba's on-disk cache instead of compiling it again."""
     if any(s.method == "moreau-jean" for s in specs):
         from .simulation import simulate
-        simulate(RodProblem.paper(2), "moreau-jean", h=1e-2, solver="lemke")
+        simulate(RodProblem.paper(2), "moreau-jean", h=1e-2, solver=DEFAULT_SOLVER)
 
 
 def run_specs(specs: list[RunSpec], refs: dict, time_limit: float, workers: int = 2,

@@ -12,7 +12,7 @@ and its exact local solution is the first consistent case of
     slip   p_T = lo·p_N (needs u_T ≥ 0) or p_T = hi·p_N (needs u_T ≤ 0),
            p_N from the normal row u_N = 0: p_N = −v_N / (a + b·bound), needs a + b·bound > 0.
 
-The Delassus matrix is held block-sparse (CSR over contacts, 2×2 blocks: `dense_to_blocks`),
+The Delassus matrix is held block-sparse (delassus.py's block layout),
 so a sweep costs O(nonzero blocks), i.e. O(contacts) for a chain or a row of bodies.
 
 Convergence is judged on the common residual relative to the problem's scale
@@ -52,7 +52,8 @@ from .kernel_base import (
     problem_scale,
 )
 from .problem import NoConvergence, PlanarFrictionProblem
-from .sticking import coupled_components, gather_contacts, group_matrix
+from .delassus import coupled_components, dense_to_blocks, group_matrix
+from .sticking import gather_contacts
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
 # corner contact of a body with rotational inertia never gets there, but e.g. a contact on
@@ -108,40 +109,6 @@ def solve_contact(a, b, c, v_n, v_t, lo, hi):
     found, p_n, p_t = local_contact_solve(float(a), float(b), float(c), float(v_n), float(v_t),
                                           float(lo), float(hi))
     return (float(p_n), float(p_t)) if found else None
-
-
-@jit
-def dense_to_blocks(W):
-    """CSR over contacts of the 2×2 blocks of W: (indptr, indices, blocks).
-
-    Blocks that are exactly zero are left out, except the diagonal ones (always present).
-    """
-    na = W.shape[0] // 2
-    indptr = np.zeros(na + 1, dtype=np.int64)
-    for i in range(na):
-        count = 0
-        for j in range(na):
-            if i == j or _block_nonzero(W, i, j):
-                count += 1
-        indptr[i + 1] = indptr[i] + count
-    indices = np.zeros(indptr[na], dtype=np.int64)
-    blocks = np.zeros((indptr[na], 2, 2))
-    for i in range(na):
-        k = indptr[i]
-        for j in range(na):
-            if i == j or _block_nonzero(W, i, j):
-                indices[k] = j
-                for r in range(2):
-                    for s in range(2):
-                        blocks[k, r, s] = W[2 * i + r, 2 * j + s]
-                k += 1
-    return indptr, indices, blocks
-
-
-@jit
-def _block_nonzero(W, i, j):
-    return (W[2 * i, 2 * j] != 0.0 or W[2 * i, 2 * j + 1] != 0.0
-            or W[2 * i + 1, 2 * j] != 0.0 or W[2 * i + 1, 2 * j + 1] != 0.0)
 
 
 @jit
@@ -357,5 +324,5 @@ def projected_gauss_seidel(
 
 __all__ = [
     "projected_gauss_seidel", "solve_contact", "local_contact_solve", "pgs_block", "pgs_dense",
-    "dense_to_blocks", "block_velocities", "solve_mode", "polish_modes",
+    "block_velocities", "solve_mode", "polish_modes",
 ]

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit, jit_borrowing, jit_inline
+from .registry import BLOCK_SPARSE_CODES, SOLVER_CODES, spec  # noqa: F401 (re-exported)
 
 # Status codes.
 KERNEL_SOLVED = 0
@@ -16,16 +17,22 @@ KERNEL_NO_CONVERGENCE = 2  # iteration/pivot limit, or an answer that misses the
 KERNEL_TOO_LARGE = 3  # enum beyond its contact limit
 KERNEL_NONFINITE = 4  # NaN/inf in the data
 
-# Solver codes.
-SOLVER_LEMKE = 0
-SOLVER_PGS = 1
-SOLVER_ENUM = 2
-SOLVER_CODES = {"lemke": SOLVER_LEMKE, "pgs": SOLVER_PGS, "enum": SOLVER_ENUM}
+# Solver codes: the table's (registry.SOLVERS), named for the compiled dispatch.
+SOLVER_LEMKE = spec("lemke").code
+SOLVER_PGS = spec("pgs").code
+SOLVER_ENUM = spec("enum").code
 STATUS_NAMES = ("solved", "ray", "no-convergence", "too-large", "non-finite")
 
 # Default acceptance (relative): the same for the three solvers, so that none of them fails
 # where another one's answer would be accepted.
 DEFAULT_RTOL = 1e-9  # = lemke.RESIDUAL_TOL and enumeration.ACCEPT_TOL
+
+
+@jit
+def takes_block_sparse(solver_code) -> bool:
+    """True when the compiled loop hands the solver of this code the block-sparse W (the
+    table's block_sparse), not the dense one; False for no compiled solver (−1)."""
+    return 0 <= solver_code < len(BLOCK_SPARSE_CODES) and BLOCK_SPARSE_CODES[solver_code]
 
 
 @jit

@@ -5,6 +5,8 @@ the friction interval [lo_i p_N, hi_i p_N] of `problem.PlanarFrictionProblem`::
 
     solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter) -> (status, iterations, residual)
 
+(`solve_interval_into`: the same in a caller's scratch; the codes are registry.SOLVERS')
+
 fills p and u = W p + q in place (p is also pgs's warm start) and returns a status code,
 the solver's iterations (Lemke pivots, pgs sweeps, enum combinations) and the common
 complementarity residual. ``rtol`` is the tolerance on that residual relative to the
@@ -15,7 +17,7 @@ enum accept DEFAULT_RTOL; pgs aims for PGS_RTOL and accepts DEFAULT_RTOL once it
 On any status but KERNEL_SOLVED, p = 0 and u = q (pgs leaves its last iterate).
 
 Large scenes: `pgs_block` on the block-sparse Delassus (indptr, indices, blocks; see
-`gauss_seidel.dense_to_blocks`) costs O(nonzero blocks) per sweep.
+`delassus.py`) costs O(nonzero blocks) per sweep.
 
 Every function here is decorated with `nonsmooth_rod._jit.jit`: numba-compiled when numba is
 installed, the same source interpreted otherwise. Float64 arrays, int64 scalars only.
@@ -27,7 +29,8 @@ import numpy as np
 
 from .._jit import jit, jit_borrowing
 from .enumeration import enum_interval
-from .gauss_seidel import dense_to_blocks, pgs_block, pgs_dense
+from .delassus import dense_to_blocks
+from .gauss_seidel import pgs_block, pgs_dense
 from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into
 
 from .kernel_base import (
@@ -37,6 +40,7 @@ from .kernel_base import (
     KERNEL_RAY,
     KERNEL_SOLVED,
     KERNEL_TOO_LARGE,
+    BLOCK_SPARSE_CODES,
     SOLVER_CODES,
     SOLVER_ENUM,
     SOLVER_LEMKE,
@@ -50,6 +54,7 @@ from .kernel_base import (
     problem_scale,
     solver_scratch,
     step_residual,
+    takes_block_sparse,
 )
 
 
@@ -108,18 +113,11 @@ def _screened(status):
     return status, 0, (np.inf if status == KERNEL_NONFINITE else 0.0)
 
 
-# One entry per solver: a loop specialised to one solver compiles only that one (issue 16).
-@jit
-def solve_lemke(W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval with SOLVER_LEMKE."""
-    floats, ints = solver_scratch(lo.shape[0])
-    return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
-
-
 @jit_borrowing
 def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-    """solve_lemke in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0]
-    contacts): what the Moreau–Jean loop calls, allocating nothing per step."""
+    """lemke_interval behind the common screen, in the scratch (floats, ints: at least
+    kernel_base.solver_scratch of these contacts — the counting callers' fitting_scratch).
+    Borrowing (the step's hot path): it allocates nothing."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
@@ -128,7 +126,7 @@ def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
 
 @jit
 def solve_pgs(W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval with SOLVER_PGS."""
+    """pgs_dense behind the common screen."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
@@ -137,32 +135,41 @@ def solve_pgs(W, q, lo, hi, p, u, rtol, max_iter):
 
 @jit
 def solve_enum(W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval with SOLVER_ENUM (max_iter has no meaning for enum)."""
+    """enum_interval behind the common screen (max_iter has no meaning for enum)."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
     return enum_interval(W, q, lo, hi, p, u, rtol, 0)
 
 
-@jit
-def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
-    """Solve the dense step problem with solver SOLVER_LEMKE | SOLVER_PGS | SOLVER_ENUM.
-
-    Fills p, u in place; returns (status, iterations, residual) (module docstring).
-    """
+@jit_borrowing
+def solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+    """The compiled dispatch: the dense step problem solved by the solver of code `solver_code`
+    (registry.SOLVERS), Lemke in the scratch (floats, ints). One branch per compiled solver of
+    the table — numba calls a kernel by its name, not out of a table; the loop reads the code at
+    run time, so every solver compiles into the one loop. Fills p, u in place; returns (status,
+    iterations, residual) (module docstring). Borrowing (the step's hot path): Lemke's scratch
+    must fit these contacts (fitting_scratch in the counting caller)."""
     if solver_code == SOLVER_LEMKE:
-        return solve_lemke(W, q, lo, hi, p, u, rtol, max_iter)
+        return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     if solver_code == SOLVER_PGS:
         return solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
     if solver_code == SOLVER_ENUM:
         return solve_enum(W, q, lo, hi, p, u, rtol, max_iter)
-    p[:] = 0.0  # an unknown solver code: nothing solved
-    u[:] = q
+    for i in range(q.shape[0]):  # an unknown solver code: nothing solved
+        p[i], u[i] = 0.0, q[i]
     return KERNEL_NO_CONVERGENCE, 0, np.inf
+
+
+@jit
+def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
+    """solve_interval_into with scratch of its own (Lemke's; the other solvers need none)."""
+    floats, ints = solver_scratch(lo.shape[0] if solver_code == SOLVER_LEMKE else 0)
+    return solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
 __all__ = [
     "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
-    "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
-    "solve_interval", "solve_lemke", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite",
+    "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "BLOCK_SPARSE_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
+    "solve_interval", "solve_interval_into", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite", "takes_block_sparse",
 ]

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit
+from .delassus import coupled_components, group_matrix
 from .problem import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK
 
 MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
@@ -581,61 +582,6 @@ def _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_t
 
 
 @jit
-def coupled_components(indptr, indices, W, label):
-    """Label the contacts by group of coupled contacts — those linked through non-zero blocks of
-    W (contacts sharing a body, directly or along a chain) — from the block-sparse layout
-    (indptr, indices) or, when indptr is empty, the dense W. Returns the number of groups."""
-    na = label.shape[0]
-    label[:] = -1
-    stack = np.empty(na, dtype=np.int64)
-    sparse = indptr.shape[0] > 0
-    groups = 0
-    for seed in range(na):
-        if label[seed] >= 0:
-            continue
-        label[seed] = groups
-        top = 1
-        stack[0] = seed
-        while top > 0:
-            top -= 1
-            i = stack[top]
-            for k in range(indptr[i] if sparse else 0, indptr[i + 1] if sparse else na):
-                j = indices[k] if sparse else k
-                if label[j] < 0 and (sparse or W[2 * i, 2 * j] != 0.0 or W[2 * i, 2 * j + 1] != 0.0
-                                     or W[2 * i + 1, 2 * j] != 0.0 or W[2 * i + 1, 2 * j + 1] != 0.0):
-                    label[j] = groups
-                    stack[top] = j
-                    top += 1
-        groups += 1
-    return groups
-
-
-@jit
-def group_matrix(members, W, indptr, indices, blocks):
-    """The dense W of one group of contacts (`members`, ascending), from W or its blocks."""
-    n = members.shape[0]
-    Wg = np.zeros((2 * n, 2 * n))
-    position = np.full(indptr.shape[0] - 1 if indptr.shape[0] > 0 else W.shape[0] // 2, -1, dtype=np.int64)
-    for a in range(n):
-        position[members[a]] = a
-    for a in range(n):
-        i = members[a]
-        if indptr.shape[0] > 0:
-            for k in range(indptr[i], indptr[i + 1]):
-                b = position[indices[k]]
-                if b >= 0:
-                    for r in range(2):
-                        for c in range(2):
-                            Wg[2 * a + r, 2 * b + c] = blocks[k, r, c]
-        else:
-            for b in range(n):
-                for r in range(2):
-                    for c in range(2):
-                        Wg[2 * a + r, 2 * b + c] = W[2 * i + r, 2 * members[b] + c]
-    return Wg
-
-
-@jit
 def gather_contacts(members, x, pairs):
     """x at the group's contacts (pairs: two entries per contact, N and T)."""
     out = np.empty(members.shape[0] * (2 if pairs else 1), dtype=x.dtype)
@@ -693,6 +639,6 @@ def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_gu
     return changed
 
 
-__all__ = ["prefer_sticking", "prefer_sticking_from", "prefer_sticking_by_group", "coupled_components", "group_matrix", "gather_contacts",
+__all__ = ["prefer_sticking", "prefer_sticking_from", "prefer_sticking_by_group", "gather_contacts",
            "scatter_contacts", "admissible_split", "simplex_max", "STATE_OPEN", "STATE_STICK", "STATE_SLIP_PLUS",
            "STATE_SLIP_MINUS", "MODE_OPEN", "MODE_STICK", "MODE_SLIDE", "MODE_FREE", "MODE_LOOSE"]

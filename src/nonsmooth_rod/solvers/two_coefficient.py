@@ -24,19 +24,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import solvers as _solvers
-from .. import _jit
 from .._jit import jit, jit_borrowing
-# The solver call point: API.md's compiled kernels (lemke, pgs, enum); the QP solvers stay
+# The solver call point: the compiled kernels (registry.SOLVERS with a code); the QP solvers stay
 # Python (solve_two_coefficient below).
-from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, SOLVER_CODES, SOLVER_ENUM, SOLVER_LEMKE, SOLVER_PGS,
-                      carve, carve_matrix, fitting_scratch, lemke_interval, pgs_block, solve_enum, solve_interval,
-                      solve_lemke_into, solve_pgs, solver_scratch)
+from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fitting_scratch, lemke_interval,
+                      pgs_block, solve_interval_into, solver_scratch)
 from ._common import interpreted
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
                       PlanarFrictionProblem, SolverError)
-from .sticking import coupled_components, gather_contacts, group_matrix, prefer_sticking_by_group, scatter_contacts
-
-COMPILED_SOLVERS = SOLVER_CODES  # solver name -> code of the compiled kernels
+from .registry import DEFAULT_SOLVER
+from .delassus import coupled_components, group_matrix
+from .sticking import gather_contacts, prefer_sticking_by_group, scatter_contacts
 
 STATE_NAMES = CONTACT_STATES  # (the codes' names, problem.py)
 # What the sign iteration does after a solve that was not consistent.
@@ -160,52 +158,15 @@ def _defaults(rtol, max_iter):
     return rtol <= 0.0 and max_iter <= 0
 
 
+@jit_borrowing
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-    """solve_interval on the dense W (Lemke in the scratch floats, ints), or pgs_or_lemke when
-    the block-sparse W is given (indptr). Returns (status, iterations, residual, 1 if pgs fell
-    back to Lemke else 0).
-
-    Compiled, a literal solver code (the Moreau–Jean loop has one entry per solver) compiles only
-    that solver (`_solve_compiled`); lemke and enum then take the dense W."""
+    """solve_interval_into on the dense W (in the scratch floats, ints), or pgs_or_lemke when the
+    block-sparse W is given (indptr). Returns (status, iterations, residual, 1 if pgs fell back
+    to Lemke else 0)."""
     if indptr.shape[0] > 0:
         return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter))
-    if solver_code == SOLVER_LEMKE:
-        status, iterations, residual = solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
-    else:
-        status, iterations, residual = solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter)
+    status, iterations, residual = solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     return status, iterations, residual, 0
-
-
-_solve.py_func = _solve  # so solvers._common.interpreted rebinds the kernels it calls
-
-if _jit.ENABLED:
-    from numba.extending import overload
-
-    @overload(_solve, prefer_literal=True)
-    def _solve_compiled(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-        """_solve for numba: one solver for a literal solver code (a cold compile then skips the
-        others: issue 16), the run-time dispatch otherwise."""
-        literal = getattr(solver_code, "literal_value", None)
-        if literal == SOLVER_LEMKE:
-            def solve_lemke_only(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-                status, iterations, residual = solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
-                return status, iterations, residual, 0
-            return solve_lemke_only
-        if literal == SOLVER_ENUM:
-            def solve_enum_only(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-                status, iterations, residual = solve_enum(W, q, lo, hi, p, u, rtol, max_iter)
-                return status, iterations, residual, 0
-            return solve_enum_only
-        if getattr(solver_code, "literal_value", None) == SOLVER_PGS:
-            def solve_pgs_either(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats,
-                                 ints):
-                if indptr.shape[0] > 0:
-                    return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter,
-                                        _defaults(rtol, max_iter))
-                status, iterations, residual = solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
-                return status, iterations, residual, 0
-            return solve_pgs_either
-        return _solve
 
 
 @jit
@@ -354,7 +315,7 @@ def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, rest
 
 
 def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: np.ndarray,
-                          slip_guess: np.ndarray, solver: str = "lemke", solver_options: dict | None = None,
+                          slip_guess: np.ndarray, solver: str = DEFAULT_SOLVER, solver_options: dict | None = None,
                           max_solves: int = MAX_SOLVES, closing: np.ndarray | None = None,
                           resting: np.ndarray | None = None) -> StepContactResult:
     """Solve u = W p + q under the exact two-coefficient law, starting from `slip_guess`, with
@@ -403,4 +364,4 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
 
 __all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_into", "two_coefficient_by_group", "StepContactResult",
            "classify_solution",
-           "next_action", "solve_interval", "SolverError", "STATE_NAMES"]
+           "next_action", "SolverError", "STATE_NAMES"]

@@ -13,13 +13,14 @@ from ..model.laws import ContactLaw
 from ..model.scene import Scene
 from ..model.shapes import rectangle_inertia as _rectangle_inertia
 from ..results import SimulationResult
+from ..solvers.registry import DEFAULT_SOLVER
 from ..validation import InputError
 
 G = 9.81
 
 
 def run(toy, method: str = "moreau-jean", t_end: float = 1.0, *, h: float = 1e-3, theta: float = 0.5,
-        solver: str = "lemke", rtol: float = 1e-12, output_dt: float = 1e-3,
+        solver: str = DEFAULT_SOLVER, rtol: float = 1e-12, output_dt: float = 1e-3,
         zeno_interval: float = 1e-9, fast: bool = True) -> SimulationResult:
     """Run a toy from its initial state through `nonsmooth_rod.simulate`: Moreau–Jean
     ("moreau-jean", step h, θ, one-step solver; `fast` allows its compiled loop) or the
