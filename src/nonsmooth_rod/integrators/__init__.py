@@ -1,7 +1,8 @@
 """The integrators, by method name. Each is imported only when a run asks for it.
 
     moreau-jean    time-stepping at velocity level, one contact problem per step (any scene)
-    event-driven   smooth modes joined by located events (disks and points on lines)
+    event-driven   smooth modes joined by located events (bodies' disks, points and polygons
+                   against fixed lines and segments)
     regularized    smooth friction and penalty contact integrated by a scipy ODE solver
 
 An integrator is a class with `name`, an options dataclass, and
@@ -23,7 +24,8 @@ MAX_OUTPUT_BYTES = 4 * 2**30
 METHODS = {
     "moreau-jean": ("moreau_jean", "MoreauJean", "MoreauJeanOptions", ("DiskOnLine", "DiskOnDisk", "DiskOnSegment",
                                                                              "SegmentEndOnEdge", "VertexOnEdge")),
-    "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine",)),
+    "event-driven": ("event_driven", "EventDriven", "EventDrivenOptions", ("DiskOnLine", "DiskOnSegment",
+                                                                             "SegmentEndOnEdge", "VertexOnEdge")),
     "regularized": ("regularized", "Regularized", "RegularizedOptions", ("DiskOnLine",)),
 }
 

@@ -30,7 +30,7 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_
                               C_CONE_1Y, C_CONE_2X, C_CONE_2Y, C_DEPTH_LIMIT, C_TIE_WINS, KIND_VERTEX_ON_EDGE,
                               KIND_FIXED_VERTEX_ON_EDGE, C_OBSTACLE_VX, C_OBSTACLE_VY,
                               C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, obstacle_velocity, C_PREV_NX,
-                              C_PREV_NY, C_NEXT_NX, C_NEXT_NY)
+                              C_PREV_NY, C_NEXT_NX, C_NEXT_NY, vertex_on_edge_region)
 from .motion import require_motion
 from .laws import ContactLaw
 
@@ -185,6 +185,26 @@ class _PackedRelation:
         w_n, w_t = obstacle_velocity(hn[0], hn[1], ht[0], ht[1], row[C_OBSTACLE_VX], row[C_OBSTACLE_VY],
                                      row[C_SURFACE_VELOCITY])  # n, t: hn[0:2], ht[0:2] (body a's side)
         return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, w_t, w_n)
+
+    def geometry_scale(self) -> float:
+        """The largest coordinate or length of this contact's geometry (m): its round-off scale."""
+        return max((abs(x) for x in self._packed_row()[3] if math.isfinite(x)), default=0.0)
+
+    def region(self, q, v) -> tuple[float, float]:
+        """(gap, margin): the gap whether or not this pair of features is the touching one, and
+        how far inside the region where it is (≥ 0: it is; the kernel's own rule,
+        `contact_kernels.vertex_on_edge_region`). A relation whose gap is finite everywhere
+        (a disk on a line, a segment, a disk) is always in its region: margin +inf. Fixed
+        obstacles at rest (the event-driven reference, which refuses driven ones)."""
+        kind, body_a, body_b, row = self._packed_row()
+        q = q if isinstance(q, list) else np.asarray(q, dtype=float).tolist()
+        v = v if isinstance(v, list) else np.asarray(v, dtype=float).tolist()
+        hn, ht = [0.0] * 6, [0.0] * 6
+        if kind == KIND_VERTEX_ON_EDGE:
+            return vertex_on_edge_region(row, body_a, body_b, q, v, hn, ht)[::3]
+        if kind == KIND_FIXED_VERTEX_ON_EDGE:
+            return vertex_on_edge_region(row, -1, body_a, q, v, hn, ht)[::3]
+        return kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht)[0], math.inf
 
 
 def _fill_disk_a(row, offset, radius) -> None:
