@@ -72,10 +72,16 @@ def test_a_disk_rolling_off_the_table_slips_and_leaves_the_edge_where_the_closed
     assert slipping < phi_leave < leaving and leaving - phi_leave < k / (mu * (3 + k))
 
 
-def test_a_point_on_a_segment_is_refused_in_one_line():
-    scene = nr.Scene([nr.RigidBody(M, 0.01)], [nr.PointOnSegment(0, (0.0, -0.05), TABLE, name="corner")], gravity=G)
-    with pytest.raises(InputError, match=r"^the event-driven integrator does not handle a point \(radius 0\) on a "
-                                         r"segment: contact 'corner' .*VertexOnEdge[^\n]*$"):
+@pytest.mark.parametrize("contact, lacks", [
+    (nr.PointOnSegment(0, (0.0, -0.05), TABLE, name="corner"), r"a point \(radius 0\) on a segment: contact 'corner'"),
+    (nr.SegmentEndOnEdge(0, (-0.1, -0.05), (0.1, -0.05), TABLE, "b", name="corner"),
+     r"a SegmentEndOnEdge \(contact 'corner'\)")], ids=["point on a segment", "segment end on an edge"])
+def test_relations_whose_normal_is_undefined_where_they_touch_are_refused_in_one_line(contact, lacks):
+    """A point on a two-sided segment takes its side from the sign of a zero gap; a segment's end on
+    an edge turns into a point-to-point contact at the edge's corner: both name the VertexOnEdge
+    that replaces them (as found contacts are)."""
+    scene = nr.Scene([nr.RigidBody(M, 0.01)], [contact], gravity=G)
+    with pytest.raises(InputError, match=rf"^the event-driven integrator does not handle {lacks}.*VertexOnEdge[^\n]*$"):
         nr.simulate(scene, np.array([-0.5, 0.05, 0.0]), np.zeros(3), 0.1, "event-driven")
 
 
@@ -151,3 +157,32 @@ def test_the_box_sliding_off_the_tables_end_example_locates_the_corner_leaving_a
     assert rear[1][1] == pytest.approx(_reaches(-MU_D * H / 2, x0, v0), abs=TIME_TOL)
     assert [e.kind for e in r.events if e.contact == "block.v1/table.side+"] == ["leave-feature"]
     assert r.impacts and r.impacts[0].contact.endswith("/floor") and edge[2][1] < r.impacts[0].t
+
+
+def test_declared_vertex_edge_contacts_hand_the_load_from_the_corner_to_the_tables_end():
+    """The same slide declared by hand (tests/integrators/test_segments.py's block, w × h = 0.2 ×
+    0.1, μ = 0.3, at 2 m/s): the corners on the table's top and the table's end on the bottom edge,
+    as VertexOnEdge contacts. The table's end enters its region touching, at no approach speed —
+    no impact —, the right corner leaves the top when the centre reaches −w/2, the left corner
+    lifts at −μ h/2, and the table's end leaves the block's edge at its corner (the pair leaves its
+    region: it opens though the edge's extension would sink under it)."""
+    w, h, mu, x0, v0 = 0.2, 0.1, 0.3, -0.5, 2.0
+    law, box, n = nr.ContactLaw.of(mu, mu, 0.0), nr.Polygon.rectangle(w, h), TABLE.normal
+    corners = [nr.VertexOnEdge(0, box.vertices[i], -1, TABLE.b, TABLE.a, cone=box.cone(i), law=law, name=name)
+               for i, name in ((0, "left"), (1, "right"))]
+    end = nr.VertexOnEdge(-1, TABLE.b, 0, *box.edge(0), cone=((-n[0], -n[1]), n), tie_wins=False, law=law, name="end")
+    scene = nr.Scene([nr.RigidBody(M, M * (w**2 + h**2) / 12)], corners + [end], gravity=G)
+    r = nr.simulate(scene, np.array([x0, h / 2, 0.0]), np.array([v0, 0.0, 0.0]), 0.6, "event-driven")
+    assert r.status == nr.Status.OK, r.message
+    phases = {name: [(p.mode, p.t_start) for p in ph] for name, ph in r.phases.items()}
+    assert [m for m, _ in phases["left"]] == ["slip+", "open"] and [m for m, _ in phases["right"]] == ["slip+", "open"]
+    assert [m for m, _ in phases["end"]] == ["open", "slip+", "open"]
+
+    def reaches(x):
+        return (v0 - math.sqrt(v0**2 - 2 * mu * G * (x - x0))) / (mu * G)
+    assert phases["right"][1][1] == pytest.approx(reaches(-w / 2 + SEAM_TOL * TABLE.length), abs=TIME_TOL)
+    assert phases["end"][1][1] == phases["right"][1][1]
+    assert phases["left"][1][1] == pytest.approx(reaches(-mu * h / 2), abs=TIME_TOL)
+    assert not r.impacts
+    assert [(e.kind, e.contact) for e in r.events[1:]] == [("enter-feature", "end"), ("leave-feature", "right"),
+                                                          ("liftoff", "left"), ("leave-feature", "end")]

@@ -16,7 +16,9 @@ zero crossings of switching indicators, evaluated on each step's dense output:
 * open contact: gap falls through 0 → impact, solved at impulse level with Newton restitution
   and two-coefficient Coulomb friction on the impulses (see solvers/two_coefficient.py); for a
   vertex–edge contact the indicator is max(gap, −margin), which reaches 0 only inside the pair's
-  region (a corner passing beside a segment's end, below its level, touches nothing).
+  region (a corner passing beside a segment's end, below its level, touches nothing); a pair
+  entering its region already touching at no approach speed closes without an impact
+  ("enter-feature").
 
 Contacts: a body's disks, points and polygons against fixed lines and segments, declared or
 found (model/collision.py); body–body contacts are refused in one line.
@@ -53,7 +55,7 @@ import scipy.integrate
 from numpy.polynomial import chebyshev
 from scipy.optimize import brentq, minimize_scalar
 
-from ..model.contacts import DiskOnSegment, VertexOnEdge
+from ..model.contacts import DiskOnSegment, SegmentEndOnEdge, VertexOnEdge
 from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
@@ -170,7 +172,7 @@ def _has_region(contact) -> bool:
     return isinstance(contact, VertexOnEdge)
 
 
-def _touchdown_value(contact, q, v) -> float:
+def _touchdown_value(contact, q, v) -> float | None:
     """Falls to 0 where the contact touches: its gap, and for a pair of features that counts
     only in a region (a corner on a segment, a table's end under a box's edge), max(gap, −margin)
     — continuous, positive while the pair is outside its region whatever its gap (a corner
@@ -247,6 +249,9 @@ def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
             sizes.append(force)
     return 1e3 * _EPS * np.array(sizes)
 
+
+# The forced mode of a contact whose pair of features has left its region (identity marks it).
+_LEFT_REGION = ["open"]
 
 # Events at one instant (to round-off): a contact that leaves or meets the line goes first, so
 # that a cone closing with N → 0 is not taken for a break-away.
@@ -477,7 +482,8 @@ class EventDriven:
         for i in range(len(kin)):
             if i in forced:
                 candidates.append(list(forced[i]))
-                decided.append(True)
+                # A pair that has left its region opens whatever its (meaningless) g̈ there.
+                decided.append(forced[i] is not _LEFT_REGION)
             elif gaps[i] > self.options.gap_tol or u_N[i] > vt:
                 candidates.append(["open"])
                 decided.append(False)
@@ -521,6 +527,11 @@ class EventDriven:
                                  f"contact {c.name!r} would take the segment's side from the sign of a zero gap, "
                                  "which round-off flips while it touches; declare it as a VertexOnEdge on the "
                                  "segment's side (as found contacts are), or give it a radius")
+            if isinstance(c, SegmentEndOnEdge):
+                raise InputError(f"the event-driven integrator does not handle a SegmentEndOnEdge (contact {c.name!r}): "
+                                 "beyond the edge it is the edge's corner against the segment's end, a normal from "
+                                 "point to point, undefined where they meet; declare it as a VertexOnEdge with "
+                                 "vertex_body = -1 (as found contacts are)")
             if len(c.bodies) != 1:
                 raise InputError(f"the event-driven integrator handles bodies against fixed obstacles only (lines, "
                                  f"segments): contact {c.name!r} joins two bodies, and it lacks a mode choice for "
@@ -622,12 +633,14 @@ class EventDriven:
             # The pair of features stops being the touching one (a corner passing the end of a
             # segment): the contact opens, and another pair (the segment's end on the body's
             # edge), if any, touches from here.
-            forced[i] = ["open"]
+            forced[i] = _LEFT_REGION
             run.events.append(Event(t, "leave-feature", names[i]))
         elif kind == "slip-zero":
             run.events.append(Event(t, "slip-zero", names[i], {"from": modes[i]}))
             # The slip velocity has just crossed zero: re-stick if μs holds, else reverse.
             forced[i] = ["stick", "slip+" if modes[i] == "slip-" else "slip-"]
+        elif kind == "touchdown" and self._enters_touching(scene, run, i):
+            run.events.append(Event(t, "enter-feature", names[i]))
         elif kind == "touchdown":
             run.instant = (math.nan, {})  # the impact changed the velocities: decide afresh
             if self._touchdown(scene, run, modes, i, names):
@@ -652,6 +665,15 @@ class EventDriven:
             new_modes = self._decide(scene, run.t, run.q, run.v, forced)
         run.instant = (run.t, merged)
         return new_modes
+
+    def _enters_touching(self, scene, run, i) -> bool:
+        """Whether a touchdown of contact i is a pair of features entering its region already
+        touching, at no approach speed (a table's end coming under a sliding box's bottom edge as
+        its corner passes it): the contact closes without an impact."""
+        if not _has_region(scene.contacts[i]):
+            return False
+        k = scene.contacts[i].kinematics(run.q, run.v, scene.n_dof)
+        return abs(float(k.H_N @ run.v) - k.normal_velocity) <= self.options.velocity_tol
 
     def _touchdown(self, scene, run, modes, i, names) -> bool:
         """Impact of contact i; True if the run stops at it."""

@@ -187,8 +187,12 @@ class _PackedRelation:
         return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, w_t, w_n)
 
     def geometry_scale(self) -> float:
-        """The largest coordinate or length of this contact's geometry (m): its round-off scale."""
-        return max((abs(x) for x in self._packed_row()[3] if math.isfinite(x)), default=0.0)
+        """The size of this contact's geometry (m): its points' largest coordinates, its radii and
+        its segment's or edge's length, summed — the scale of its gap's round-off."""
+        row = self._packed_row()[3]
+        points = sum(max(abs(row[x]), abs(row[y])) for x, y in ((C_OFF_AX, C_OFF_AY), (C_OFF_BX, C_OFF_BY),
+                                                                (C_LINE_PX, C_LINE_PY)))
+        return points + row[C_RADIUS_A] + row[C_RADIUS_B] + row[C_SEGMENT_LENGTH]
 
     def region(self, q, v) -> tuple[float, float]:
         """(gap, margin): the gap whether or not this pair of features is the touching one, and
