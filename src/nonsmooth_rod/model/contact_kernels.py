@@ -308,7 +308,8 @@ _TINY_MARGIN = 1e-300
 @jitable
 def vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht):
     """(gap, Ḣ_N v, Ḣ_T v, margin) of a vertex on an edge, whether or not the pair is the touching
-    one: the gap finite, the margin `_pair_margin` (the kernel's rule: counted iff margin ≥ 0).
+    one: the gap finite, the margin `_pair_margin` (the kernel's rule: counted iff margin ≥ 0;
+    below 0 the drifts are left at 0).
     The event-driven reference locates where a contact enters or leaves its region from it."""
     ca, sa, px, py, rpx, rpy, vax, vay, om_a = _frame(point_body, q, v, row, C_OFF_AX, C_OFF_AY)
     if point_body < 0:
@@ -331,6 +332,8 @@ def vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht):
         _fill_rows(hn, ht, 0, nx, ny, rqx, rqy, -1.0)
         _clear_side(hn, ht, 1)
     margin = _pair_margin(row, along, gap, dx, dy, tx, ty, nx, ny, cb, sb, ca, sa)
+    if not margin >= 0.0:
+        return gap, 0.0, 0.0, margin  # not the touching pair: no drifts (the kernel's gap is infinite)
     # w: velocity of P's material point relative to E's; at fixed v the levers turn, so
     # d/dt Ṗ = −ω_a² r_P and d/dt Ė = −ω_b² r_E, while n turns by ω_b τ and τ by −ω_b n.
     wx, wy = vax - om_a * rpy - vbx + om_b * rey, vay + om_a * rpx - vby - om_b * rex
