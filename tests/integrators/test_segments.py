@@ -113,6 +113,11 @@ def test_a_block_slides_over_the_end_of_a_table_tips_on_its_edge_and_falls():
     assert r.trajectory.q[-1, 1] < -0.2 and np.all(r.trajectory.normal_force[r.trajectory.t > 0.5] == 0.0)
 
 
-def test_the_event_driven_reference_refuses_segments_in_one_line():
-    with pytest.raises(InputError, match="event-driven.*does not handle DiskOnSegment contacts"):
-        nr.simulate(_ball_scene(), np.array([-0.5, 0.4, 0.0]), np.zeros(3), 0.1, "event-driven")
+def test_the_event_driven_reference_refuses_body_body_vertex_edge_contacts_in_one_line():
+    """It handles segments (tests/integrators/test_event_driven_segments.py), not two bodies' contacts."""
+    box = nr.Polygon.rectangle(0.2, 0.1)
+    bodies = [nr.RigidBody(M, 0.01, name="lower"), nr.RigidBody(M, 0.01, name="upper")]
+    scene = nr.Scene(bodies, nr.find_contacts(bodies, {"lower": box, "upper": box}, {"floor": nr.Line()}), gravity=G)
+    with pytest.raises(InputError, match=r"^the event-driven integrator handles bodies against fixed obstacles only "
+                                         r"\(lines, segments\): contact 'lower.v0/upper.e0' joins two bodies[^\n]*$"):
+        nr.simulate(scene, np.array([0.0, 0.05, 0.0, 0.0, 0.15, 0.0]), np.zeros(6), 0.1, "event-driven")

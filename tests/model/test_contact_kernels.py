@@ -377,3 +377,41 @@ def test_a_point_that_crossed_two_edges_counts_against_the_least_penetrated(thet
     assert corner.kinematics(at, np.zeros(6), 6).gap == pytest.approx(-0.02, abs=1e-12)
     at[3] = 0.01  # its corner 1 cm inside the left side, 2 cm into the top: the side cannot push it
     assert corner.kinematics(at, np.zeros(6), 6).gap == pytest.approx(-0.02, abs=1e-12)
+
+
+def test_the_region_margin_is_the_kernels_rule():
+    """`region` gives the gap whether or not the pair of features counts, and a margin ≥ 0 exactly
+    where the kernel counts it (a finite gap) — the event-driven reference locates entering and
+    leaving the region where the margin crosses 0."""
+    contacts = _box_pair_contacts(True)
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        q = np.array([rng.uniform(-1.2, 1.2), rng.uniform(0.9, 1.1), rng.uniform(-0.4, 0.4), 0.0, 0.0, 0.0])
+        v = rng.normal(size=6)
+        for c in contacts:
+            k = c.kinematics(q, v, 6)
+            gap, margin = c.region(q, v)
+            assert (margin >= 0.0) == math.isfinite(k.gap), c.name
+            assert math.isfinite(gap) and (gap == k.gap or not math.isfinite(k.gap))
+
+
+def test_a_corner_passing_a_segments_end_leaves_its_region_continuously():
+    """A box's corner sliding flat along a table's top (found contacts) past the table's end: its
+    gap stays 0 and the margin is the distance of its foot inside the end, + SEAM_TOL × length,
+    changing sign where the kernel stops counting the pair (within FACE_TOL of it: flat faces sit
+    on the boundary of the corner's cone, widened by FACE_TOL, which bounds the margin)."""
+    from nonsmooth_rod.model.collision import Polygon, find_contacts
+    from nonsmooth_rod.model.contact_kernels import FACE_TOL, SEAM_TOL
+
+    class Body:
+        name = "box"
+    table = Segment((-2.0, 0.0), (0.0, 0.0), name="table")
+    contacts = {c.name: c for c in find_contacts([Body()], {"box": Polygon.rectangle(0.4, 0.2)}, {"table": table})}
+    corner = contacts["box.v1/table.side+"]  # the bottom right corner, at x + 0.2, on the top
+    for x_corner in (-0.01, -1e-6, 1e-6, 0.01):
+        q, v = [x_corner - 0.2, 0.1, 0.0], [1.0, 0.0, 0.0]
+        gap, margin = corner.region(q, v)
+        assert gap == pytest.approx(0.0, abs=1e-15)
+        assert margin == pytest.approx(-x_corner + SEAM_TOL * table.length, abs=1e-15)
+        assert math.isfinite(corner.kinematics(q, v, 3).gap) == (x_corner < 0)
+    assert corner.region([-1.0, 0.1, 0.0], [0.0, 0.0, 0.0])[1] == pytest.approx(FACE_TOL, abs=1e-15)

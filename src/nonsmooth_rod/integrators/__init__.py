@@ -1,7 +1,8 @@
 """The integrators, by method name. Each is imported only when a run asks for it.
 
     moreau-jean    time-stepping at velocity level, one contact problem per step (any scene)
-    event-driven   smooth modes joined by located events (disks and points on lines)
+    event-driven   smooth modes joined by located events (bodies' disks, points and polygons
+                   against fixed lines and segments)
     regularized    smooth friction and penalty contact integrated by a scipy ODE solver
     hybrid         fixed explicit Runge–Kutta steps in each smooth mode, the event-driven events
 

@@ -9,8 +9,19 @@ zero crossings of switching indicators, evaluated on each step's dense output:
   else slip the other way (the re-stick test the paper's treatment misses);
   and det A (A = H_N M⁻¹ (H_N − s μd H_T)) falls to 0: Painlevé, stop with status "painleve";
 * closed contact: N falls through 0 → contact opens (flight);
+* closed vertex–edge contact: its pair of features stops being the touching one (a box's corner
+  passing the end of a table: the margin of `VertexOnEdge.region` falls through 0) → it opens
+  ("leave-feature"), and the pair that takes over (the table's end under the box's edge) is
+  decided at that instant;
 * open contact: gap falls through 0 → impact, solved at impulse level with Newton restitution
-  and two-coefficient Coulomb friction on the impulses (see solvers/two_coefficient.py).
+  and two-coefficient Coulomb friction on the impulses (see solvers/two_coefficient.py); for a
+  vertex–edge contact the indicator is max(gap, −margin), which reaches 0 only inside the pair's
+  region (a corner passing beside a segment's end, below its level, touches nothing); a pair
+  entering its region already touching at no approach speed closes without an impact
+  ("enter-feature").
+
+Contacts: a body's disks, points and polygons against fixed lines and segments, declared or
+found (model/collision.py); body–body contacts are refused in one line.
 
 A reference must never miss an event, so sign changes between steps are not enough: an
 indicator may cross and come back within one step (T/N above μs for microseconds near its
@@ -44,13 +55,14 @@ import scipy.integrate
 from numpy.polynomial import chebyshev
 from scipy.optimize import brentq, minimize_scalar
 
+from ..model.contacts import DiskOnSegment, SegmentEndOnEdge, VertexOnEdge
 from ..model.dynamics import SLIP_SIGN, mode_dynamics
 from ..model.scene import Scene
 from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from ..solvers.registry import SolverName
-from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration
+from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration, Refusal
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
@@ -112,7 +124,7 @@ class _Indicator:
     """A switching function of the current mode: the event `kind` of `contact` happens where its
     value crosses zero in `direction` (+1 rising, −1 falling)."""
 
-    kind: str  # touchdown, liftoff, break-upper, break-lower, slip-zero, painleve
+    kind: str  # touchdown, liftoff, break-upper, break-lower, slip-zero, painleve, leave-feature
     contact: int
     direction: int
     offset: float = 0.0  # subtracted from the value
@@ -127,6 +139,8 @@ def _indicators(scene, modes, force_tol: float) -> list[_Indicator]:
             out.append(_Indicator("touchdown", i, -1))
             continue
         out.append(_Indicator("liftoff", i, -1))
+        if _has_region(scene.contacts[i]):
+            out.append(_Indicator("leave-feature", i, -1))
         if mode == "stick":
             # A frictionless contact holds only with T = 0, known to round-off: it breaks away
             # when it would need a tangential force beyond the force tolerance.
@@ -141,6 +155,24 @@ def _indicators(scene, modes, force_tol: float) -> list[_Indicator]:
     return out
 
 
+def _has_region(contact) -> bool:
+    """Whether the contact counts only while its pair of features is the touching one (a vertex
+    on an edge: its gap is infinite elsewhere), so that entering and leaving that region are
+    events (`_PackedRelation.region`)."""
+    return isinstance(contact, VertexOnEdge)
+
+
+def _touchdown_value(contact, q, v) -> float | None:
+    """Falls to 0 where the contact touches: its gap, and for a pair of features that counts
+    only in a region (a corner on a segment, a table's end under a box's edge), max(gap, −margin)
+    — continuous, positive while the pair is outside its region whatever its gap (a corner
+    passing beside a segment's end, below its level), 0 when it enters the region touching."""
+    if not _has_region(contact):
+        return None
+    gap, margin = contact.region(q, v)
+    return max(gap, -margin)
+
+
 def _indicator_values(scene, modes, indicators, t, y, kin=None, dyn=None) -> np.ndarray:
     """Values of the indicators at state y (the mode's dynamics are solved once, if needed;
     kin and dyn: the kinematics and the mode's dynamics at y when the caller has them)."""
@@ -151,7 +183,10 @@ def _indicator_values(scene, modes, indicators, t, y, kin=None, dyn=None) -> np.
     for j, ind in enumerate(indicators):
         k = kin[ind.contact]
         if ind.kind == "touchdown":
-            value = k.gap
+            value = _touchdown_value(scene.contacts[ind.contact], q, v)
+            value = k.gap if value is None else value
+        elif ind.kind == "leave-feature":
+            value = scene.contacts[ind.contact].region(q, v)[1]
         elif ind.kind == "slip-zero":
             value = k.H_T @ v - k.surface_velocity
         else:
@@ -194,11 +229,10 @@ def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
     sizes = []
     for j, ind in enumerate(indicators):
         contact = scene.contacts[ind.contact]
-        if ind.kind == "touchdown":
-            sizes.append(length + contact.radius + float(np.max(np.abs(contact.line.point)))
-                         + float(np.max(np.abs(contact.offset))))
+        if ind.kind in ("touchdown", "leave-feature"):
+            sizes.append(length + contact.geometry_scale())
         elif ind.kind == "slip-zero":
-            sizes.append(speed * (1.0 + length) + abs(contact.line.velocity))
+            sizes.append(speed * (1.0 + length) + abs(getattr(getattr(contact, "line", None), "velocity", 0.0)))
         elif ind.kind == "painleve":
             sizes.append(abs(start[j]))
         else:
@@ -206,9 +240,12 @@ def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
     return 1e3 * _EPS * np.array(sizes)
 
 
+# The forced mode of a contact whose pair of features has left its region (identity marks it).
+_LEFT_REGION = ["open"]
+
 # Events at one instant (to round-off): a contact that leaves or meets the line goes first, so
 # that a cone closing with N → 0 is not taken for a break-away.
-_PRIORITY = {"liftoff": 0, "touchdown": 0}
+_PRIORITY = {"liftoff": 0, "touchdown": 0, "leave-feature": 0}
 
 
 def _first_of(found, indicators):
@@ -230,10 +267,19 @@ class _Watch:
     leaving the band on the wrong side is an event there.
     """
 
-    def __init__(self, scene, modes, indicators, t0, y0):
+    def __init__(self, scene, modes, indicators, t0, y0, gap_tol=0.0):
         self.scene, self.modes, self.indicators, self.t0 = scene, list(modes), indicators, t0
         self.sign = -np.array([ind.direction for ind in indicators], dtype=float)
         self.noise = _noise_levels(scene, modes, indicators, t0, y0)
+        touchdowns = [j for j, ind in enumerate(indicators) if ind.kind == "touchdown"]
+        if touchdowns and gap_tol > 0.0:
+            # A contact that has just opened starts at the gap its closed phase drifted to (the
+            # integration error of g̈ = 0 on a turning normal, a pivot: ~1e-12 m), which the
+            # switch accepted as closed (≤ gap_tol): its band is that drift.
+            start = np.abs(_indicator_values(scene, modes, indicators, t0, y0))
+            for j in touchdowns:
+                if start[j] <= gap_tol:
+                    self.noise[j] = max(self.noise[j], 2.0 * start[j])
         self.band_exit = np.full(len(indicators), math.inf)  # when each first left its start band
         self._cached = {}
         self.evaluations = 0
@@ -360,7 +406,7 @@ def _force_scale(scene, t, q, v) -> float:
 
 
 class EventDriven:
-    """Event-driven integrator for scenes whose contacts are disks or points on lines."""
+    """Event-driven integrator for scenes of bodies against fixed lines and segments."""
 
     name = "event-driven"
 
@@ -426,7 +472,8 @@ class EventDriven:
         for i in range(len(kin)):
             if i in forced:
                 candidates.append(list(forced[i]))
-                decided.append(True)
+                # A pair that has left its region opens whatever its (meaningless) g̈ there.
+                decided.append(forced[i] is not _LEFT_REGION)
             elif gaps[i] > self.options.gap_tol or u_N[i] > vt:
                 candidates.append(["open"])
                 decided.append(False)
@@ -496,7 +543,7 @@ class EventDriven:
         Returns the event's (kind, contact), or None at t_end; leaves the run at the stop."""
         indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
         y0 = np.concatenate([run.q, run.v])
-        watch = _Watch(scene, modes, indicators, run.t, y0)
+        watch = _Watch(scene, modes, indicators, run.t, y0, self.options.gap_tol)
         solver = self._solver(scene, modes, run.t, y0, t_end)
         hit = None
         try:
@@ -550,10 +597,18 @@ class EventDriven:
         elif kind == "liftoff":
             forced[i] = ["open"]
             run.events.append(Event(t, "liftoff", names[i]))
+        elif kind == "leave-feature":
+            # The pair of features stops being the touching one (a corner passing the end of a
+            # segment): the contact opens, and another pair (the segment's end on the body's
+            # edge), if any, touches from here.
+            forced[i] = _LEFT_REGION
+            run.events.append(Event(t, "leave-feature", names[i]))
         elif kind == "slip-zero":
             run.events.append(Event(t, "slip-zero", names[i], {"from": modes[i]}))
             # The slip velocity has just crossed zero: re-stick if μs holds, else reverse.
             forced[i] = ["stick", "slip+" if modes[i] == "slip-" else "slip-"]
+        elif kind == "touchdown" and self._enters_touching(scene, run, i):
+            run.events.append(Event(t, "enter-feature", names[i]))
         elif kind == "touchdown":
             run.instant = (math.nan, {})  # the impact changed the velocities: decide afresh
             if self._touchdown(scene, run, modes, i, names):
@@ -578,6 +633,15 @@ class EventDriven:
             new_modes = self._decide(scene, run.t, run.q, run.v, forced)
         run.instant = (run.t, merged)
         return new_modes
+
+    def _enters_touching(self, scene, run, i) -> bool:
+        """Whether a touchdown of contact i is a pair of features entering its region already
+        touching, at no approach speed (a table's end coming under a sliding box's bottom edge as
+        its corner passes it): the contact closes without an impact."""
+        if not _has_region(scene.contacts[i]):
+            return False
+        k = scene.contacts[i].kinematics(run.q, run.v, scene.n_dof)
+        return abs(float(k.H_N @ run.v) - k.normal_velocity) <= self.options.velocity_tol
 
     def _touchdown(self, scene, run, modes, i, names) -> bool:
         """Impact of contact i; True if the run stops at it."""
@@ -710,6 +774,32 @@ class EventDriven:
         return Trajectory(ts, y[:, :n_dof], y[:, n_dof:], a, N, T, modes)
 
 
+def _first_contact(kind):
+    """A refusal's finder: the fields naming the scene's first contact `kind(contact)` holds for."""
+    def finds(scene, options=None, duration=None):
+        found = next((c for c in scene.contacts if kind(c)), None)
+        return None if found is None else {"name": found.name}
+    return finds
+
+
+# What the reference cannot run among the relations it takes, each said in one line.
+POINT_ON_SEGMENT = Refusal(
+    _first_contact(lambda c: isinstance(c, DiskOnSegment) and c.radius == 0.0),
+    "the event-driven integrator does not handle a point (radius 0) on a segment: contact {name!r} would take the "
+    "segment's side from the sign of a zero gap, which round-off flips while it touches; declare it as a "
+    "VertexOnEdge on the segment's side (as found contacts are), or give it a radius")
+SEGMENT_END = Refusal(
+    _first_contact(lambda c: isinstance(c, SegmentEndOnEdge)),
+    "the event-driven integrator does not handle a SegmentEndOnEdge (contact {name!r}): beyond the edge it is the "
+    "edge's corner against the segment's end, a normal from point to point, undefined where they meet; declare it "
+    "as a VertexOnEdge with vertex_body = -1 (as found contacts are)")
+BODY_ON_BODY = Refusal(
+    _first_contact(lambda c: len(c.bodies) != 1),
+    "the event-driven integrator handles bodies against fixed obstacles only (lines, segments): contact {name!r} "
+    "joins two bodies, and it lacks a mode choice for them (tried, it slides two stacked boxes that μs holds); use "
+    "moreau-jean")
+
 EventDriven.declares = Declaration(
-    options=EventDrivenOptions, contacts=("DiskOnLine",), samples_estimate=EventDriven.samples_estimate,
-    samples_knob=EventDriven.SAMPLES_KNOB, refusals=(NO_JOINTS, NO_DRIVEN, STEP_CAP))
+    options=EventDrivenOptions, contacts=("DiskOnLine", "DiskOnSegment", "SegmentEndOnEdge", "VertexOnEdge"),
+    samples_estimate=EventDriven.samples_estimate, samples_knob=EventDriven.SAMPLES_KNOB,
+    refusals=(NO_JOINTS, NO_DRIVEN, STEP_CAP, POINT_ON_SEGMENT, SEGMENT_END, BODY_ON_BODY))

@@ -242,9 +242,17 @@ def _vertex_feature_valid(row, along, length, dx, dy, ca, sa):
 @jitable
 def _in_cone(row, dx, dy, ca, sa):
     """Whether the direction d lies in the vertex's normal cone (within FACE_TOL)."""
+    return _cone_margin(row, dx, dy, ca, sa) >= 0.0
+
+
+@jitable
+def _cone_margin(row, dx, dy, ca, sa):
+    """How far (a sine) the direction d lies inside the vertex's normal cone widened by FACE_TOL:
+    ≥ 0 inside (the sign of a sum of two floats is the sign of the exact sum: the same test as
+    comparing each side with −FACE_TOL)."""
     n1x, n1y = ca * row[C_CONE_1X] - sa * row[C_CONE_1Y], sa * row[C_CONE_1X] + ca * row[C_CONE_1Y]
     n2x, n2y = ca * row[C_CONE_2X] - sa * row[C_CONE_2Y], sa * row[C_CONE_2X] + ca * row[C_CONE_2Y]
-    return n1x * dy - n1y * dx >= -FACE_TOL and dx * n2y - dy * n2x >= -FACE_TOL
+    return min(n1x * dy - n1y * dx, dx * n2y - dy * n2x) + FACE_TOL
 
 
 @jitable
@@ -275,13 +283,47 @@ def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
     of `edge_body` (−1: fixed), the edge's outward normal n = τ turned by −90° (a CCW outline).
     Gap n·(P − E) − r; the edge's touching point is the foot Q = E + (τ·(P − E)) τ. An infinite
     gap: the pair is not the touching one (the foot beyond the edge, a wrong cone, too deep)."""
+    gap, drift_n, drift_t, margin = vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht)
+    if not margin >= 0.0:
+        return math.inf, 0.0, 0.0
+    return gap, drift_n, drift_t
+
+
+@jitable
+def _pair_margin(row, along, gap, dx, dy, tx, ty, nx, ny, cb, sb, ca, sa):
+    """How far inside the region where the vertex–edge pair is the touching one (m; at the cone,
+    a sine): ≥ 0 inside. Continuous in the foot's place, the depth and the cone; the discrete
+    rules (face-to-face seams, the least penetrated edge) put it just below 0."""
+    r, length = row[C_RADIUS_A], row[C_SEGMENT_LENGTH]
+    tol = SEAM_TOL * length
+    margin = min(along + tol, length + tol - along, gap + row[C_DEPTH_LIMIT])
+    if r == 0.0:
+        margin = min(margin, _cone_margin(row, -nx, -ny, ca, sa))
+    if margin >= 0.0 and r == 0.0 and not _vertex_feature_valid(row, along, length, -nx, -ny, ca, sa):
+        return -_TINY_MARGIN
+    if margin >= 0.0 and gap < 0.0 and not _least_penetrated(row, dx, dy, gap + r, tx, ty, length, cb, sb, ca, sa,
+                                                             r == 0.0):
+        return -_TINY_MARGIN
+    return margin
+
+
+# A margin just below zero: the pair is outside by a discrete rule, not by a distance.
+_TINY_MARGIN = 1e-300
+
+
+@jitable
+def vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht):
+    """(gap, Ḣ_N v, Ḣ_T v, margin) of a vertex on an edge, whether or not the pair is the touching
+    one: the gap finite, the margin `_pair_margin` (the kernel's rule: counted iff margin ≥ 0;
+    below 0 the drifts are left at 0).
+    The event-driven reference locates where a contact enters or leaves its region from it."""
     ca, sa, px, py, rpx, rpy, vax, vay, om_a = _frame(point_body, q, v, row, C_OFF_AX, C_OFF_AY)
     if point_body < 0:
         px, py = row[C_LINE_PX], row[C_LINE_PY]
     cb, sb, ex, ey, rex, rey, vbx, vby, om_b = _frame(edge_body, q, v, row, C_OFF_BX, C_OFF_BY)
     tx, ty = cb * row[C_EDGE_TX] - sb * row[C_EDGE_TY], sb * row[C_EDGE_TX] + cb * row[C_EDGE_TY]
     nx, ny = ty, -tx
-    r, length = row[C_RADIUS_A], row[C_SEGMENT_LENGTH]
+    r = row[C_RADIUS_A]
     dx, dy = px - ex, py - ey
     along = dx * tx + dy * ty
     gap = dx * nx + dy * ny - r
@@ -295,21 +337,16 @@ def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
     else:
         _fill_rows(hn, ht, 0, nx, ny, rqx, rqy, -1.0)
         _clear_side(hn, ht, 1)
-    tol = SEAM_TOL * length
-    valid = -tol <= along <= length + tol and gap >= -row[C_DEPTH_LIMIT]
-    if valid and r == 0.0:
-        valid = _vertex_feature_valid(row, along, length, -nx, -ny, ca, sa)
-    if valid and gap < 0.0:
-        valid = _least_penetrated(row, dx, dy, gap + r, tx, ty, length, cb, sb, ca, sa, r == 0.0)
-    if not valid:
-        return math.inf, 0.0, 0.0
+    margin = _pair_margin(row, along, gap, dx, dy, tx, ty, nx, ny, cb, sb, ca, sa)
+    if not margin >= 0.0:
+        return gap, 0.0, 0.0, margin  # not the touching pair: no drifts (the kernel's gap is infinite)
     # w: velocity of P's material point relative to E's; at fixed v the levers turn, so
     # d/dt Ṗ = −ω_a² r_P and d/dt Ė = −ω_b² r_E, while n turns by ω_b τ and τ by −ω_b n.
     wx, wy = vax - om_a * rpy - vbx + om_b * rey, vay + om_a * rpx - vby - om_b * rex
     accx, accy = -om_a * om_a * rpx + om_b * om_b * rex, -om_a * om_a * rpy + om_b * om_b * rey
     drift_n = -om_b * om_b * (gap + r) + 2.0 * om_b * (tx * wx + ty * wy) + nx * accx + ny * accy
     drift_t = om_b * (nx * wx + ny * wy) + ny * accx - nx * accy
-    return gap, drift_n, drift_t
+    return gap, drift_n, drift_t, margin
 
 
 @jitable

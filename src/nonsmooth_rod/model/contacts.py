@@ -31,7 +31,7 @@ from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OFF_AX, C_OFF_
                               KIND_FIXED_VERTEX_ON_EDGE, C_OBSTACLE_VX, C_OBSTACLE_VY,
                               C_OBSTACLE_START_VX, C_OBSTACLE_START_VY, obstacle_velocity, C_PREV_NX,
                               C_PREV_NY, C_NEXT_NX, C_NEXT_NY, C_LINEAR_GAP0, C_LINEAR_N, C_LINEAR_T,
-                              KIND_LINEAR)
+                              KIND_LINEAR, vertex_on_edge_region)
 from .motion import require_motion
 from .laws import ContactLaw
 
@@ -186,6 +186,30 @@ class _PackedRelation:
         w_n, w_t = obstacle_velocity(hn[0], hn[1], ht[0], ht[1], row[C_OBSTACLE_VX], row[C_OBSTACLE_VY],
                                      row[C_SURFACE_VELOCITY])  # n, t: hn[0:2], ht[0:2] (body a's side)
         return ContactKinematics(gap, H_N, H_T, drift_n, drift_t, w_t, w_n)
+
+    def geometry_scale(self) -> float:
+        """The size of this contact's geometry (m): its points' largest coordinates, its radii and
+        its segment's or edge's length, summed — the scale of its gap's round-off."""
+        row = self._packed_row()[3]
+        points = sum(max(abs(row[x]), abs(row[y])) for x, y in ((C_OFF_AX, C_OFF_AY), (C_OFF_BX, C_OFF_BY),
+                                                                (C_LINE_PX, C_LINE_PY)))
+        return points + row[C_RADIUS_A] + row[C_RADIUS_B] + row[C_SEGMENT_LENGTH]
+
+    def region(self, q, v) -> tuple[float, float]:
+        """(gap, margin): the gap whether or not this pair of features is the touching one, and
+        how far inside the region where it is (≥ 0: it is; the kernel's own rule,
+        `contact_kernels.vertex_on_edge_region`). A relation whose gap is finite everywhere
+        (a disk on a line, a segment, a disk) is always in its region: margin +inf. Fixed
+        obstacles at rest (the event-driven reference, which refuses driven ones)."""
+        kind, body_a, body_b, row = self._packed_row()
+        q = q if isinstance(q, list) else np.asarray(q, dtype=float).tolist()
+        v = v if isinstance(v, list) else np.asarray(v, dtype=float).tolist()
+        hn, ht = [0.0] * 6, [0.0] * 6
+        if kind == KIND_VERTEX_ON_EDGE:
+            return vertex_on_edge_region(row, body_a, body_b, q, v, hn, ht)[::3]
+        if kind == KIND_FIXED_VERTEX_ON_EDGE:
+            return vertex_on_edge_region(row, -1, body_a, q, v, hn, ht)[::3]
+        return kinematics_kernel(kind, row, body_a, body_b, q, v, hn, ht)[0], math.inf
 
 
 def _fill_disk_a(row, offset, radius) -> None:
