@@ -202,18 +202,21 @@ def test_polyline_is_named_segments():
         nr.Polyline([(0, 0), (0, 0)], name="ground")
 
 
-def test_the_event_driven_reference_runs_polygons_on_lines_and_refuses_segments_in_one_line():
+def test_the_event_driven_reference_runs_polygons_on_lines_and_on_segments():
     """A box pushed along a floor stops after v0²/(2 μ g): its found corner contacts are points
-    on a line, which the event-driven method locates; on a segment it names what it lacks."""
+    on a line, which the event-driven method locates; on a table segment (vertex–edge contacts)
+    it stops at the same place."""
     box = _box("box", 1.0, 0.4, 0.2)
     shape = {"box": nr.Polygon.rectangle(0.4, 0.2)}
     contacts = find_contacts([box], shape, {"floor": nr.Line()}, nr.PairLaws(default=nr.ContactLaw.of(0.5)))
     result = nr.simulate(nr.Scene([box], contacts), np.array([0.0, 0.1, 0.0]), np.array([0.5, 0.0, 0.0]), 0.3,
                          "event-driven")
     assert result.trajectory.q[-1, 0] == pytest.approx(0.5 ** 2 / (2 * 0.5 * G), rel=1e-8)
-    on_table = find_contacts([box], shape, {"table": nr.Segment((-1.0, 0.0), (1.0, 0.0))})
-    with pytest.raises(nr.InputError, match="'event-driven' does not handle VertexOnEdge contacts"):
-        nr.simulate(nr.Scene([box], on_table), np.array([0.0, 0.1, 0.0]), np.zeros(3), 0.1, "event-driven")
+    on_table = find_contacts([box], shape, {"table": nr.Segment((-1.0, 0.0), (1.0, 0.0))},
+                             nr.PairLaws(default=nr.ContactLaw.of(0.5)))
+    result = nr.simulate(nr.Scene([box], on_table), np.array([0.0, 0.1, 0.0]), np.array([0.5, 0.0, 0.0]), 0.3,
+                         "event-driven")
+    assert result.trajectory.q[-1, 0] == pytest.approx(0.5 ** 2 / (2 * 0.5 * G), rel=1e-8)
 
 
 def test_boxes_and_a_ball_dropped_in_a_heap_do_not_pass_through_each_other():
