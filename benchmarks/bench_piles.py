@@ -1,7 +1,7 @@
 """Cost per Moreau–Jean step of the rows and piles of `toys/stacks.py`, side by side with MuJoCo
 (planar), PyBullet and pymunk in one run (issue 26), and the drift of a pile at rest.
 
-    python benchmarks/bench_piles.py [--quick] [--repeats 3] [--steps 500] [--drift STEPS]
+    python benchmarks/bench_piles.py [--quick] [--repeats 3] [--steps 500] [--drift STEPS] [--only TEXT]
 
 Scenes: a row of N balls on a floor, N = 2, 4, …, 256, the first rolling at 1 m/s into the others
 (μ 0.3/0.2); a pyramid pile of 4 and of 8 rows of disks between two walls on a floor (μ 0.5/0.4,
@@ -15,7 +15,8 @@ scene): ratios are what to read on a shared machine. The last columns: ours ÷ M
 
 `--drift STEPS`: the 8-row pile at rest for STEPS steps (10⁵ in the issue) with pgs, and the
 largest |q − q0| over the run (goal: < 1e-10). `--quick`: N = 2, 8, the 4-row pile, 50 steps, one
-repeat, drift over 200 steps of the 4-row pile (the test runs it).
+repeat, drift over 200 steps of the 4-row pile (the test runs it). `--only TEXT`: only the scenes
+whose name contains TEXT (e.g. `--only "N=16"`, `--only pile`), repeatable.
 """
 from __future__ import annotations
 
@@ -77,11 +78,13 @@ def drift(rows: int, steps: int, h: float = 1e-3):
     return float(np.max(np.abs(run.q - q0))), run
 
 
-def table(quick: bool, steps: int, repeats: int, h: float = 1e-3):
+def table(quick: bool, steps: int, repeats: int, h: float = 1e-3, only=()):
     """Print one line per scene and engine; returns {scene: {engine: µs}} and the yardsticks."""
     costs, yards = {}, []
     print(f"{'scene':18s} {'contacts':>8s} {'engine':>10s} {'us/step':>9s} {'x yd':>7s} {'/ mujoco':>8s}  note")
     for name, (scene, q0, v0), peer_scene, with_lemke in scenes(quick):
+        if only and not any(text in name for text in only):
+            continue
         yard = yardstick_us(n=5000, repeats=3)
         yards.append(yard)
         row = {}
@@ -110,12 +113,15 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--steps", type=int, default=500)
     parser.add_argument("--drift", type=int, default=0, metavar="STEPS")
+    parser.add_argument("--only", action="append", default=[], metavar="TEXT",
+                        help="only the scenes whose name contains TEXT (repeatable)")
     args = parser.parse_args(argv)
     steps, repeats = (50, 1) if args.quick else (args.steps, args.repeats)
     for peer, settings in planar_peers.PEER_SETTINGS.items():
         print(f"# {peer}: {settings}")
-    _, yards = table(args.quick, steps, repeats)
-    print(f"yardstick (3x3 numpy.linalg.solve in a Python loop): median {statistics.median(yards):.2f} us")
+    _, yards = table(args.quick, steps, repeats, only=args.only)
+    if yards:
+        print(f"yardstick (3x3 numpy.linalg.solve in a Python loop): median {statistics.median(yards):.2f} us")
     if args.drift or args.quick:
         rows, n = (4, 200) if args.quick else (8, args.drift)
         largest, run = drift(rows, n)

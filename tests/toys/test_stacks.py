@@ -92,3 +92,15 @@ def test_bench_piles_quick_runs(capsys):
     assert "max |q - q0| =" in out
     largest = float(out.split("max |q - q0| =")[1].split()[0])
     assert largest < 1e-10
+
+
+@pytest.mark.parametrize("solver", ["pgs", "lemke"])
+def test_newtons_cradle_row_passes_the_first_balls_velocity_to_the_last(solver):
+    """Frictionless balls a gap apart, e = 1: each impact is a two-ball elastic collision of equal
+    masses, which exchanges their velocities (momentum and energy conserved), so after the wave the
+    last ball leaves with the first's 1 m/s and the others stand still — to round-off of the speed."""
+    scene, q0, v0 = stacks.ball_row(5, law=ContactLaw.of(0.0, 0.0, 1.0))
+    run = nr.simulate(scene, q0, v0, 0.02, h=1e-4, solver=solver)
+    assert run.status == "ok", run.message
+    assert run.v[-1][0::3] == pytest.approx([0, 0, 0, 0, 1.0], abs=1e-12)
+    assert run.v[-1][1::3] == pytest.approx(np.zeros(5), abs=1e-12)
