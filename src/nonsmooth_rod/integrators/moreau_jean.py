@@ -32,7 +32,7 @@ from ..model.scene import Scene
 from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
 from ..solvers.registry import DEFAULT_SOLVER, EXACT_SOLVERS, SOLVER_CODES, SolverName, check_solver_options
 from ..solvers._common import interpreted
-from ..solvers.problem import SolverError
+from ..solvers.problem import STATE_OPEN, SolverError
 from ..solvers.two_coefficient import STATE_NAMES, solve_two_coefficient
 from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
@@ -448,8 +448,11 @@ class MoreauJean:
             return "failed", (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
                               f"passed through its obstacle within a step; use a smaller h than {grid.h:g} s"), None
         r = k - window.k_base
-        state_txt = ", ".join(f"{name}:{STATE_NAMES[states[r - 1, i]] if r else 'initial'}"
-                              for i, name in enumerate(names))
+        state_txt = _states_text(names, states[r - 1] if r else None)
+        closed = int(np.count_nonzero(states[r - 1] != STATE_OPEN)) if r else 0
+        if closed > q.shape[1]:  # (measured on the 50-box heap: no duplicate rows, not the pivot limit)
+            state_txt += (f"; {closed} contacts closed on {q.shape[1]} degrees of freedom: a redundant, "
+                          "degenerate step problem whose solution failed the solver's accuracy check")
         where = f"step {k}, t = {t_k:.9g} s, contact states {state_txt}, q = {np.array2string(q[r], precision=6)}"
         if self._solver_error is not None:
             message = str(self._solver_error.with_context(where))
@@ -527,6 +530,21 @@ def joint_forces(joints, impulses_over_h) -> dict:
     F along its line's normal and torque M on body_a (N, N·m: the step's impulses / h)."""
     return {joint.name: {what: impulses_over_h[:, ROWS_PER_JOINT * i + r]
                          for r, what in enumerate(REACTION_NAMES[joint.kind])} for i, joint in enumerate(joints)}
+
+
+# A failure message lists every contact's state up to this many contacts; beyond, only those not
+# open (a heap of 50 boxes lists 39 800 candidates: a message of a megabyte).
+MESSAGE_ALL_STATES = 12
+
+
+def _states_text(names, states) -> str:
+    """The contacts' states at the step before a failure ('initial' at the first step)."""
+    if states is None:
+        return ", ".join(f"{name}:initial" for name in names[:MESSAGE_ALL_STATES]) + (
+            f" (+{len(names) - MESSAGE_ALL_STATES} more)" if len(names) > MESSAGE_ALL_STATES else "")
+    shown = [i for i in range(len(names)) if len(names) <= MESSAGE_ALL_STATES or states[i] != STATE_OPEN]
+    text = ", ".join(f"{names[i]}:{STATE_NAMES[states[i]]}" for i in shown)
+    return text if len(shown) == len(names) else f"{text} (the other {len(names) - len(shown)} open)"
 
 
 _KERNEL_FAILURES = {1: "no valid solution of the step problem (secondary ray)",

@@ -190,8 +190,12 @@ def polygon_pair_contacts(poly_a, body_a, name_a, poly_b, body_b, name_b, law, t
     found = []
     for (pv, bv, nv, pe, be, ne, wins) in ((poly_a, body_a, name_a, poly_b, body_b, name_b, tie_to_first),
                                            (poly_b, body_b, name_b, poly_a, body_a, name_a, not tie_to_first)):
-        for i, vertex in enumerate(pv.vertices):
-            for k in range(len(pe.vertices)):
+        # Edge by edge, each edge's vertices of the other polygon from the last: two faces that
+        # touch give their corners in the edge's direction (a CCW outline runs the other way on
+        # the facing side), the order a hand-written scene lists them (Lemke's pivots follow it).
+        for k in range(len(pe.vertices)):
+            for i in reversed(range(len(pv.vertices))):
+                vertex = pv.vertices[i]
                 found.append(VertexOnEdge(bv, vertex, be, *pe.edge(k), cone=pv.cone(i), tie_wins=wins,
                                           depth_limit=depth, law=law, name=f"{nv}.v{i}/{ne}.e{k}",
                                           neighbours=pe.neighbours(k)))
@@ -331,6 +335,10 @@ def find_contacts(bodies, shapes: dict, obstacles: dict | None = None, laws: Pai
             for key, contact in _pair(a[:3], b[:3], laws.law(a[3], b[3])):
                 if key not in taken:
                     found.append(contact)
+    # By the later body of each pair (stable): body k's contacts with the bodies before it and the
+    # obstacles come together, in the order a hand-written scene lists them (each body on what
+    # holds it) — the active contacts' order is the solver's (Lemke's pivots follow it).
+    found.sort(key=lambda c: max(c.bodies))
     return found
 
 
