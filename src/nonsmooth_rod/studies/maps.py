@@ -254,13 +254,14 @@ class _Job:
         points = _grid_points(self.axes)
         todo = [p for p in points if runner.point_key(p) not in done]
         new: list[dict] = []
+        lines: dict = {}  # the new rows' CSV lines, formatted once (runner.row_sink)
         with runner.progress(self.progress, len(points)) as bar, \
-                runner.row_sink(self.out_dir / CSV_NAME, self.columns, bar, new) as record_rows:
+                runner.row_sink(self.out_dir / CSV_NAME, self.columns, bar, new, lines) as record_rows:
             bar.advance(len(points) - len(todo))
             self.points(pool, workers, todo, record_rows)
         compute_s = time.perf_counter() - started
         every = runner.sorted_unique(earlier + new, self.paths)
-        runner.write_table(self.out_dir / CSV_NAME, every, self.columns, self.paths)
+        runner.write_table(self.out_dir / CSV_NAME, every, self.columns, self.paths, lines)
         wanted = {runner.point_key(p) for p in points}
         rows = [r for r in every if runner.row_key(r, self.paths) in wanted]
         boundaries = refine_boundaries(self, rows, pool, workers) if self.refine else []

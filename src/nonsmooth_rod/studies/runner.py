@@ -98,6 +98,21 @@ def row_lines(rows, columns) -> str:
     return buf.getvalue()
 
 
+def each_row_line(rows, columns) -> list[str]:
+    """Each row's CSV line (row_lines cut per row): kept by the sink, so the final table joins
+    them instead of formatting every cell a second time (10⁴ points × 40 columns: 0.2 s)."""
+    buf = io.StringIO()
+    writer, ends = csv.writer(buf, lineterminator="\n"), []
+    for row in rows:
+        writer.writerow([_cell(row[c]) for c in columns])
+        ends.append(buf.tell())
+    text, start, lines = buf.getvalue(), 0, []
+    for end in ends:
+        lines.append(text[start:end])
+        start = end
+    return lines
+
+
 def _parse_row(fields, columns, text_columns, key_columns, required) -> dict | None:
     if len(fields) != len(columns):
         return None
@@ -143,9 +158,13 @@ def sorted_unique(rows, key_columns) -> list[dict]:
     return [unique[k] for k in sorted(unique, key=lambda k: k[::-1])]
 
 
-def write_table(path, rows, columns, key_columns) -> None:
+def write_table(path, rows, columns, key_columns, lines: dict | None = None) -> None:
+    """The table, one row per point in order, atomically; `lines`: rows' CSV lines already
+    formatted (by id of the row: row_sink's), the others formatted here."""
     header = row_lines([dict(zip(columns, columns))], columns)  # quoted where a name holds a comma
-    write_text(path, header + row_lines(sorted_unique(rows, key_columns), columns))
+    lines = lines or {}
+    body = "".join(lines.get(id(r)) or row_lines([r], columns) for r in sorted_unique(rows, key_columns))
+    write_text(path, header + body)
 
 
 def write_parquet(path: Path, csv_path: Path, columns, text_columns) -> Path:
@@ -269,13 +288,17 @@ def executor_pool(executor, jobs: int, scheduler, csv_path: Path):
 
 
 @contextlib.contextmanager
-def row_sink(csv_path: Path, columns, bar, collected: list):
+def row_sink(csv_path: Path, columns, bar, collected: list, lines: dict | None = None):
     """`record_rows(rows)`: append finished rows to the sweep's CSV as they arrive (a row on disk
-    is a row an interrupted sweep need not redo), keep them in `collected`, advance the bar."""
+    is a row an interrupted sweep need not redo), keep them in `collected` (and each one's line in
+    `lines`, by id, for write_table), advance the bar."""
     with open(csv_path, "a", newline="", encoding="utf-8") as sink:
         def record_rows(rows):
+            texts = each_row_line(rows, columns)
+            if lines is not None:
+                lines.update(zip(map(id, rows), texts))
             try:
-                sink.write(row_lines(rows, columns))
+                sink.write("".join(texts))
                 sink.flush()
             except OSError as err:  # a full disk: the rows written stay, a resume redoes the rest
                 raise output_error(csv_path, err) from None
