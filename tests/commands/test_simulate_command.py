@@ -69,6 +69,8 @@ def test_direct_mass_properties(tmp_path, capsys):
         (["--method", "moreau-jean", "--h", "0"], "--h must be positive"),
         (["--method", "moreau-jean", "--h", "nan"], "--h: must be a finite number"),
         (["--method", "moreau-jean", "--solver", "magic"], "unknown --solver 'magic'; choose from: lemke, pgs, enum"),
+        (["--method", "event-driven", "--solver", "magic"], "unknown --solver 'magic'"),
+        (["--method", "hybrid", "--solver", "magic"], "unknown --solver 'magic'"),
         (["--method", "moreau-jean", "--theta", "0.3"], "gain energy"),
         (["--t-end", "-1"], "--t-end must be positive"),
         (["--bogus"], "unrecognized arguments"),

@@ -93,9 +93,7 @@ def _cell(value) -> str:
 
 
 def row_lines(rows, columns) -> str:
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerows([[_cell(row[c]) for c in columns] for row in rows])
-    return buf.getvalue()
+    return "".join(each_row_line(rows, columns))
 
 
 def each_row_line(rows, columns) -> list[str]:
