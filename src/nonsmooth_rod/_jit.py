@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import warnings
+import re
 from pathlib import Path
 
 
@@ -126,12 +127,57 @@ def jitable(function):
 # numba recompiles a cached kernel when its own source file changes, not when a kernel it calls
 # (and compiled into itself) changes: after an edit of solvers/lemke.py the Moreau–Jean loop
 # would go on running the old Lemke from the cache. A digest of the package's sources, kept
-# next to the cache, drops every cached kernel of the package when any source changed.
+# next to the cache, drops every cached kernel of the package when any of them changed. It covers
+# the modules that hold compiled code and every package module they import at module level (where
+# a kernel's globals come from: constants, other kernels); an edit elsewhere (the driver, results,
+# studies, the CLI…) cannot change a compiled kernel and keeps the cache.
 _purged = False
+_COMPILED = re.compile(r"^@(jit|jit_borrowing|jit_inline|jitable|_inlined)\b", re.MULTILINE)
 
 
-def _package_sources() -> list[Path]:
-    return sorted(Path(__file__).resolve().parent.rglob("*.py"))
+def _module_imports(path: Path, package_root: Path) -> set[Path]:
+    """The package's source files `path` imports at module level (function-level imports cannot
+    reach a compiled kernel's globals)."""
+    import ast
+
+    here = path.parent
+    found = set()
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.ImportFrom) and node.level:
+            base = here
+            for _ in range(node.level - 1):
+                base = base.parent
+            module = base.joinpath(*node.module.split(".")) if node.module else base
+            for alias in node.names:
+                candidates = ((module / alias.name).with_suffix(".py"), module / alias.name / "__init__.py",
+                              module.with_suffix(".py"), module / "__init__.py")
+                found.update(next(([c] for c in candidates if c.is_file()), []))
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
+            for name in names:
+                parts = name.split(".")
+                if parts[0] == package_root.name:
+                    stem = package_root.parent.joinpath(*parts)
+                    found.update(c for c in (stem.with_suffix(".py"), stem / "__init__.py") if c.is_file())
+    return found
+
+
+def _package_root() -> Path:
+    return Path(__file__).resolve().parent
+
+
+def _package_sources(root: Path | None = None) -> list[Path]:
+    """The sources a cached kernel can depend on: the modules with compiled functions and,
+    transitively, the package modules they import at module level."""
+    root = _package_root() if root is None else root
+    todo = [path for path in root.rglob("*.py") if _COMPILED.search(path.read_text(encoding="utf-8"))]
+    seen: set[Path] = set()
+    while todo:
+        path = todo.pop()
+        if path not in seen:
+            seen.add(path)
+            todo.extend(_module_imports(path, root) - seen)
+    return sorted(seen)
 
 
 def _cache_dir_of(source: Path) -> Path:
@@ -153,30 +199,43 @@ def sources_digest() -> str:
     return digest.hexdigest()
 
 
+def _sources_stat() -> str:
+    """Every package source's size and modification time: while it is unchanged so is the
+    digest, and checking it costs a directory walk (~1 ms) instead of parsing the sources."""
+    root = _package_root()
+    return "\n".join(f"{path.relative_to(root)} {stat.st_size} {stat.st_mtime_ns}"
+                     for path in sorted(root.rglob("*.py")) for stat in [path.stat()])
+
+
 def purge_stale_kernels() -> bool:
-    """Drop the package's cached kernels and compile markers when its sources changed since they
-    were cached; True when it purged. Costs ~1 ms (hashing the sources) once per process."""
+    """Drop the package's cached kernels and compile markers when the sources they depend on
+    changed since they were cached; True when it purged. Costs ~1 ms once per process while no
+    source changed (their sizes and times), ~0.3 s after an edit (the digest)."""
     global _purged
     _purged = True
     stamp = _marker("sources").with_suffix(".digest")
-    current = sources_digest()
     try:
-        if stamp.read_text() == current:
-            return False
+        recorded_digest, _, recorded_stat = stamp.read_text().partition("\n")
     except OSError:
-        pass
-    for source in _package_sources():
-        folder = _cache_dir_of(source)
-        for cached in list(folder.glob(f"{source.stem}.*.nbi")) + list(folder.glob(f"{source.stem}.*.nbc")):
-            cached.unlink(missing_ok=True)
-    for marker in stamp.parent.glob("nonsmooth-rod-*.compiled"):
-        marker.unlink(missing_ok=True)
+        recorded_digest = recorded_stat = None
+    stat = _sources_stat()
+    if stat == recorded_stat:
+        return False
+    current = sources_digest()
+    purged = current != recorded_digest
+    if purged:
+        for source in _package_sources():
+            folder = _cache_dir_of(source)
+            for cached in list(folder.glob(f"{source.stem}.*.nbi")) + list(folder.glob(f"{source.stem}.*.nbc")):
+                cached.unlink(missing_ok=True)
+        for marker in stamp.parent.glob("nonsmooth-rod-*.compiled"):
+            marker.unlink(missing_ok=True)
     try:
         stamp.parent.mkdir(parents=True, exist_ok=True)
-        stamp.write_text(current)
+        stamp.write_text(f"{current}\n{stat}")
     except OSError:
         pass  # a read-only cache: numba cannot write there either
-    return True
+    return purged
 
 
 __all__ = ["jit", "ENABLED", "one_blas_thread", "compiling", "compile_in_background", "start_compile_job", "compile_policy"]

@@ -38,11 +38,14 @@ def test_a_writable_package_folder_keeps_numbas_default(monkeypatch):
 
 # ------------------------------------------------------------ stale cached kernels
 def test_changed_sources_drop_the_packages_cached_kernels_and_compile_markers(monkeypatch, tmp_path):
-    source, cache = tmp_path / "src" / "loop.py", tmp_path / "cache"
-    source.parent.mkdir()
+    package, cache = tmp_path / "pkg", tmp_path / "cache"
+    package.mkdir()
     cache.mkdir()
-    source.write_text("x = 1\n")
-    monkeypatch.setattr(_jit, "_package_sources", lambda: [source])
+    source = package / "loop.py"
+    source.write_text("from .consts import K\n\n@jit\ndef run():\n    return K\n")
+    (package / "consts.py").write_text("K = 1\n")
+    (package / "cli.py").write_text("from .loop import run\n\ndef main():\n    return run()\n")
+    monkeypatch.setattr(_jit, "_package_root", lambda: package)
     monkeypatch.setattr(_jit, "_cache_dir_of", lambda path: cache)
     monkeypatch.setattr(_jit, "_marker", lambda part="engine": cache / f"nonsmooth-rod-9.9-{part}.compiled")
 
@@ -51,16 +54,33 @@ def test_changed_sources_drop_the_packages_cached_kernels_and_compile_markers(mo
             (cache / name).write_text("")
         (cache / "nonsmooth-rod-9.9-lemke.compiled").touch()
 
+    def edit(path, text):  # a new size, so the check on sizes and times sees it on any file system
+        path.write_text(text)
+
     cached_files()
     assert _jit.purge_stale_kernels()  # no digest yet: whatever is cached may be stale
     assert sorted(p.name for p in cache.iterdir()) == ["nonsmooth-rod-9.9-sources.digest", "other.run-3.py311.nbi"]
     cached_files()
     assert not _jit.purge_stale_kernels()  # the same sources: the cache stays
     assert (cache / "loop.run-10.py311.nbi").exists() and (cache / "nonsmooth-rod-9.9-lemke.compiled").exists()
-    source.write_text("x = 2\n")  # a kernel's source changed: its callers' cached code is stale
+    edit(package / "cli.py", "from .loop import run\n\ndef main():\n    return 2 * run()\n")
+    assert not _jit.purge_stale_kernels()  # no kernel depends on the CLI: the cache stays
+    assert (cache / "loop.run-10.py311.nbi").exists()
+    edit(package / "consts.py", "K = 22\n")  # a constant a kernel compiled in: its cached code is stale
     assert _jit.purge_stale_kernels()
     assert not (cache / "loop.run-10.py311.nbi").exists() and not (cache / "loop.run-10.py311.1.nbc").exists()
     assert not (cache / "nonsmooth-rod-9.9-lemke.compiled").exists()
+    cached_files()
+    edit(source, "from .consts import K\n\n@jit\ndef run():\n    return K + 1\n")  # the kernel itself
+    assert _jit.purge_stale_kernels()
+    assert not (cache / "loop.run-10.py311.nbi").exists()
+
+
+def test_the_kernel_sources_are_the_compiled_modules_and_what_they_import():
+    names = {str(path.relative_to(_jit._package_root())) for path in _jit._package_sources()}
+    assert {"integrators/moreau_jean_loop.py", "solvers/lemke.py", "solvers/kernels.py",
+            "model/contact_kernels.py", "solvers/registry.py"} <= names
+    assert not names & {"driver.py", "cli.py", "results.py", "studies/runner.py", "integrators/moreau_jean.py"}
 
 
 def test_the_purged_folders_are_where_numba_caches_the_kernels():
