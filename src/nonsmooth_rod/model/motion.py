@@ -22,7 +22,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .._jit import jit, jitable
 from ..validation import InputError, quoted, require_finite, require_index, require_nonnegative
@@ -150,6 +149,8 @@ def _piecewise_cubic(times, positions, interpolation: str) -> np.ndarray:
         if interpolation == "linear":
             values[:-1, VALUE_LINEAR:VALUE_LINEAR + 3] = np.diff(y, axis=0) / np.diff(times)[:, None]
         else:
+            from scipy.interpolate import CubicSpline  # here: a spline motion is rare, the import ~0.2 s
+
             c = CubicSpline(times, y, bc_type=SPLINE_BOUNDARY).c  # (4, rows − 1, 3): s³, s², s, 1
             for column, power in ((VALUE_CUBIC, 0), (VALUE_QUADRATIC, 1), (VALUE_LINEAR, 2)):
                 values[:-1, column:column + 3] = c[power]
