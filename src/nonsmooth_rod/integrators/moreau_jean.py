@@ -29,7 +29,7 @@ from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
-from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
+from ..results import Event, Impact, Phase, SimulationResult, Status, Trajectory, phases_from_intervals
 from ..solvers.registry import DEFAULT_SOLVER, EXACT_SOLVERS, SOLVER_CODES, SolverName, check_solver_options
 from ..solvers._common import interpreted
 from ..solvers.problem import STATE_OPEN, SolverError
@@ -176,6 +176,17 @@ def _run_data(plan, q0, v0, grid: Grid, resume):
     return model, work, v0
 
 
+# A window's records a scene's plan lends to its next run, up to this many rows (a short run's:
+# zeroing a long window's rows again would cost more than new zeroed pages).
+LENT_WINDOW_ROWS = 4096
+
+
+def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> Window:
+    """The run's window: with the records an earlier run of the scene lent (zeroed), or new."""
+    out = plan.borrow(HISTORY + chunk) if HISTORY + chunk <= LENT_WINDOW_ROWS else None
+    return Window(n_dof, n_contacts, chunk, joint_rows, out)
+
+
 def _chunk_size(grid: Grid, stopping: bool) -> int:
     """Steps per window: the whole run up to MAX_CHUNK; with a stop condition, a 64th of the run
     (tried between windows: a stop costs at most ~2/64 of the run past the step where it holds)."""
@@ -207,7 +218,10 @@ def compiled_part(solver: str, solver_code, callback: bool):
     the compiled loop."""
     if solver_code is None:
         return "moreau-jean-python-step", "the step kernels around Python solvers", ["--python-step", solver]
-    return "moreau-jean", f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})", []  # callbacks run it step by step
+    return "moreau-jean", _LOOP_IN_WORDS, []  # callbacks run it step by step
+
+
+_LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
 
 
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
@@ -285,7 +299,7 @@ class MoreauJean:
         plan = scene_plan(scene)  # packed once for the runs that repeat the scene
         packed, names = plan.packed, list(plan.names)
         model, work, v0 = _run_data(plan, q0, v0, grid, resume)
-        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
+        window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
@@ -303,7 +317,9 @@ class MoreauJean:
                  "compiled": engine.compiled and solver_code is not None,
                  "force_callback": self._calls_back}
         result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
-        plan.give_back(WORK_KEY, work)  # the result keeps copies of what it needs from it
+        plan.give_back(WORK_KEY, work)  # the result keeps copies of what it needs from them
+        if window.rows <= LENT_WINDOW_ROWS:
+            plan.give_back(window.rows, window.out)
         return result
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
@@ -326,11 +342,12 @@ class MoreauJean:
         if varies_in_time is None:
             varies_in_time = scene.forces_vary_in_time()
         solver_code = SOLVER_CODES.get(opts.solver)
-        solver_options = dict(opts.solver_options)
-        params = np.zeros(loop.N_PARAMS)
-        params[loop.P_H], params[loop.P_THETA], params[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
-        params[loop.P_H_GRID] = opts.h
-        params[loop.P_T0], params[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
+        solver_options = opts.solver_options
+        values = [0.0] * loop.N_PARAMS  # one array from Python floats: cheaper than writing its items
+        values[loop.P_H], values[loop.P_THETA], values[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
+        values[loop.P_H_GRID] = opts.h
+        values[loop.P_T0], values[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
+        params = np.array(values, dtype=float)
         iparams = np.array([-1 if solver_code is None else solver_code,
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
                             names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1,
@@ -465,22 +482,22 @@ class MoreauJean:
         q, states, counters = out[0], out[5], out[9]
         t_end = float(grid.time(k_end))
         if status == loop.RUN_OK:
-            return "ok", f"reached t_end = {grid.t_end:g} s", None
+            return Status.OK, f"reached t_end = {grid.t_end:g} s", None
         if status == loop.RUN_STOPPED:
-            return "ok", f"stopped at the impact of {self.options.stop_at_impact}", None
+            return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
         if status == loop.RUN_STOPPED_BY_CONDITION:
-            return "stopped", f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
+            return Status.STOPPED, f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
         k = window.k_base + int(counters[loop.K_FAIL_STEP])  # the failing step
         t_k = float(grid.origin + k * grid.h)
         if status == loop.RUN_NONFINITE:
-            return "failed", f"non-finite state at step {k + 1}, t = {float(grid.time(k + 1)):.9g} s", None
+            return Status.FAILED, f"non-finite state at step {k + 1}, t = {float(grid.time(k + 1)):.9g} s", None
         if status == loop.RUN_BAD_GEOMETRY:
             name = names[int(counters[loop.K_FAIL_CONTACT])]
-            return "failed", (f"{name}: disk centres coincide at step {k}, t = {t_k:.9g} s, the contact "
+            return Status.FAILED, (f"{name}: disk centres coincide at step {k}, t = {t_k:.9g} s, the contact "
                               "normal is undefined"), None
         if status == loop.RUN_PASSED_THROUGH:
             name = names[int(counters[loop.K_FAIL_CONTACT])]
-            return "failed", (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
+            return Status.FAILED, (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
                               f"passed through its obstacle within a step; use a smaller h than {grid.h:g} s"), None
         r = k - window.k_base
         state_txt = _states_text(names, states[r - 1] if r else None)
@@ -493,7 +510,7 @@ class MoreauJean:
             message = str(self._solver_error.with_context(where))
         else:
             message = f"{self.options.solver}: {_KERNEL_FAILURES.get(int(counters[loop.K_SOLVER_STATUS]), 'failed')} ({where})"
-        return "failed", message, Event(t_k, "solver-failure", "", {"message": message})
+        return Status.FAILED, message, Event(t_k, "solver-failure", "", {"message": message})
 
     def _impacts(self, scene, grid, collector, names):
         minv = scene.inverse_mass_diagonal
@@ -525,18 +542,17 @@ class MoreauJean:
             phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop)
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
-        n_done = k_end - grid.first
-        stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
-                     solver_iterations=int(counters[loop.K_ITERATIONS]),
-                     inconsistent_steps=int(counters[loop.K_INCONSISTENT]),
-                     solver_fallbacks=int(counters[loop.K_FALLBACKS]),
-                     steps_at_rest=int(counters[loop.K_REPEATED]))
+        n_done, counts = k_end - grid.first, counters.tolist()
+        stats = dict(stats, steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
+                     inconsistent_steps=counts[loop.K_INCONSISTENT], solver_fallbacks=counts[loop.K_FALLBACKS],
+                     steps_at_rest=counts[loop.K_REPEATED])
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
                                   impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
         result.defer(locate)
         if status == "failed":  # located now: a failed run's contacts may not bear evaluating later
             result._settle()
-        result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
+        if scene.joints:
+            result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)

@@ -127,10 +127,11 @@ class Window:
 
     Row r holds the state at step k_base + r and the records of the step leaving it."""
 
-    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0):
+    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0, out=None):
+        """`out`: zeroed records of this shape lent by an earlier run (integrators/scene_plans.py)."""
         rows = HISTORY + chunk
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
-        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows)
+        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows) if out is None else out
         self.rows, self.k_base, self.r = rows, 0, 0
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
