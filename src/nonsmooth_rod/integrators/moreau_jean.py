@@ -478,13 +478,13 @@ class MoreauJean:
 
     def _ending(self, status, k_end, grid, window, names):
         """(status word, message, solver-failure event or None) of how the run ended at step k_end."""
-        out = window.out
-        q, states, counters = out[0], out[5], out[9]
-        t_end = float(grid.time(k_end))
         if status == loop.RUN_OK:
             return Status.OK, f"reached t_end = {grid.t_end:g} s", None
         if status == loop.RUN_STOPPED:
             return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
+        out = window.out
+        q, states, counters = out[0], out[5], out[9]
+        t_end = float(grid.time(k_end))
         if status == loop.RUN_STOPPED_BY_CONDITION:
             return Status.STOPPED, f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
         k = window.k_base + int(counters[loop.K_FAIL_STEP])  # the failing step

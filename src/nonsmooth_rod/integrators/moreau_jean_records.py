@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -106,11 +107,12 @@ class Grid:
         t_before = origin + (first + n - 1) * h
         return cls(origin, first, n - 1, h, t_end - t_before, t_end)
 
-    @property
+    # (computed once: a grid is never changed after Grid.of, and a run reads these a dozen times)
+    @cached_property
     def n_steps(self) -> int:
         return self.n_full + (1 if self.h_last else 0)
 
-    @property
+    @cached_property
     def last(self) -> int:
         return self.first + self.n_steps
 

@@ -28,7 +28,7 @@ from ..model.joints import pack_joints
 from ..model.motion import Prescribed
 from ..model.packing import pack_scene
 
-# Scenes kept (the most recently packed first out when full) and the largest kept: beyond it
+# Scenes kept (the earliest packed first out when full) and the largest kept: beyond it
 # packing is a small part of any run, and the arrays are not worth keeping.
 MAX_PLANS = 8
 MAX_PLAN_CONTACTS = 4096
@@ -115,7 +115,10 @@ def scene_plan(scene) -> ScenePlan:
     if _keepable(scene, plan):
         plan.packed.weight = np.array(plan.packed.weight)  # its own: not the scene's array, changed in place later
         if len(_PLANS) >= MAX_PLANS:
-            _PLANS.pop(next(iter(_PLANS)))
+            try:  # the oldest out (another thread may be changing the table meanwhile)
+                _PLANS.pop(next(iter(_PLANS)), None)
+            except (RuntimeError, StopIteration):
+                pass
         kept = (tuple(scene.contacts), tuple(scene.forces), tuple(scene.joints), tuple(scene.driven),
                 scene.applied_force)
         _PLANS[key] = (scene, fingerprint, kept, plan)
