@@ -163,11 +163,11 @@ class Window:
         self.r = keep
 
     def resume_state(self, grid: Grid, work, last_h: float, on_grid: bool) -> ResumeState:
-        keep = min(HISTORY, self.r)
-        lo = self.r - keep
-        return ResumeState(grid.origin if on_grid else grid.t_end, self.k_base + self.r if on_grid else 0, grid.h,
-                           on_grid, last_h, self.out[0][lo: self.r + 1].copy(), self.out[1][lo: self.r + 1].copy(),
-                           *(a[lo: self.r].copy() for a in self.out[2:6]),
+        r, out = self.r, self.out
+        lo = r - min(HISTORY, r)
+        return ResumeState(grid.origin if on_grid else grid.t_end, self.k_base + r if on_grid else 0, grid.h,
+                           on_grid, last_h, out[0][lo: r + 1].copy(), out[1][lo: r + 1].copy(), out[2][lo: r].copy(),
+                           out[3][lo: r].copy(), out[4][lo: r].copy(), out[5][lo: r].copy(),
                            work[WORK_CLOSED].copy(), work[WORK_GRAZING].copy(), work[WORK_SLIP_SIGN].copy())
 
 
