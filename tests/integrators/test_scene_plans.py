@@ -147,3 +147,21 @@ def test_kept_plans_are_bounded():
         scene_plan(scene)
     assert len(scene_plans._PLANS) == scene_plans.MAX_PLANS
     assert scene_plan(scenes[-1]) is scene_plan(scenes[-1])
+
+
+def test_the_arrays_a_plan_lends_are_bounded():
+    """A few sets (runs of many lengths do not pile up windows), each small (a long run's window is
+    not kept)."""
+    from nonsmooth_rod.integrators.moreau_jean import _lend_window
+    from nonsmooth_rod.integrators.moreau_jean_records import Window
+
+    scene = ball_scene()
+    for steps in range(5, 5 + 3 * scene_plans.MAX_SPARES):
+        nr.simulate(scene, Q0, V0, steps * H, h=H)
+    plan = scene_plan(scene)
+    assert len(plan._spares) == scene_plans.MAX_SPARES
+    long_window = Window(scene.n_dof, 1, 50_000)
+    _lend_window(plan, long_window)
+    assert long_window.rows not in plan._spares
+    taken = plan.borrow("work")
+    assert taken is not None and plan.borrow("work") is None  # one run at a time

@@ -176,15 +176,20 @@ def _run_data(plan, q0, v0, grid: Grid, resume):
     return model, work, v0
 
 
-# A window's records a scene's plan lends to its next run, up to this many rows (a short run's:
-# zeroing a long window's rows again would cost more than new zeroed pages).
-LENT_WINDOW_ROWS = 4096
+# A window's records a scene's plan lends to its next run, up to this size (a short run's: zeroing
+# a long window's rows again would cost more than new zeroed pages, and a plan keeps them).
+LENT_WINDOW_BYTES = 1 << 18
 
 
 def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> Window:
     """The run's window: with the records an earlier run of the scene lent (zeroed), or new."""
-    out = plan.borrow(HISTORY + chunk) if HISTORY + chunk <= LENT_WINDOW_ROWS else None
-    return Window(n_dof, n_contacts, chunk, joint_rows, out)
+    return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk))
+
+
+def _lend_window(plan, window: Window) -> None:
+    """The window's records back to the scene's plan, for its next run of as many rows, when small."""
+    if sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES:
+        plan.give_back(window.rows, window.out)
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -318,8 +323,7 @@ class MoreauJean:
                  "force_callback": self._calls_back}
         result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
         plan.give_back(WORK_KEY, work)  # the result keeps copies of what it needs from them
-        if window.rows <= LENT_WINDOW_ROWS:
-            plan.give_back(window.rows, window.out)
+        _lend_window(plan, window)
         return result
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:

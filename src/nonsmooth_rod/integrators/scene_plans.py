@@ -14,8 +14,9 @@ hands the same plan back while nothing the packing read has changed:
   LinearRelation's or a LinearJoint's dict rows) or with driven obstacles or bodies (the loop
   writes their rows while it runs) is packed again for every run, as before.
 
-The per-run arrays a plan lends (the loop's `Work`, a window's `Records`) go to one run at a
-time and come back zeroed; nothing a result keeps points into them.
+The per-run arrays a plan lends (the loop's `Work`, a short run's window `Records`: a few sets,
+each small) go to one run at a time and come back zeroed; nothing a result keeps points into them.
+Plans and what they lend are per process: a study's workers each pack their scene once.
 """
 from __future__ import annotations
 
@@ -32,6 +33,8 @@ from ..model.packing import pack_scene
 # packing is a small part of any run, and the arrays are not worth keeping.
 MAX_PLANS = 8
 MAX_PLAN_CONTACTS = 4096
+# Sets of per-run arrays a plan lends (the Work, windows of a few lengths).
+MAX_SPARES = 4
 _PLANS: dict = {}  # id(scene) → (scene, fingerprint, what the fingerprint's ids name, plan)
 _IMMUTABLE = (float, int, str, bool, type(None))
 
@@ -56,20 +59,22 @@ class ScenePlan:
         self._spares: dict = {}
 
     def borrow(self, key):
-        """Arrays lent under `key` by an earlier run, zeroed, or None (first run, or lent now)."""
-        spares = self._spares.get(key)
-        if not spares:
-            return None
-        try:
-            arrays = spares.pop()
-        except IndexError:  # another thread took it meanwhile
-            return None
-        for a in arrays:
-            a.fill(0)
+        """The arrays lent under `key` by an earlier run, zeroed, or None (none lent, or another
+        run holds them: each goes to one run at a time)."""
+        arrays = self._spares.pop(key, None)
+        if arrays is not None:
+            for a in arrays:
+                a.fill(0)
         return arrays
 
     def give_back(self, key, arrays) -> None:
-        self._spares.setdefault(key, []).append(arrays)
+        """Lend `arrays` to the next run that asks for `key` (one set a key, MAX_SPARES keys)."""
+        if key not in self._spares and len(self._spares) >= MAX_SPARES:
+            try:  # the earliest lent out
+                self._spares.pop(next(iter(self._spares)), None)
+            except (RuntimeError, StopIteration):
+                return
+        self._spares[key] = arrays
 
 
 def _fingerprint(scene):
