@@ -162,7 +162,8 @@ class SimulationResult:
     joint_forces: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        self.status = Status(self.status)
+        if type(self.status) is not Status:  # (an Enum's call costs a microsecond even on a member)
+            self.status = Status(self.status)
 
     @property
     def success(self) -> bool:

@@ -7,6 +7,7 @@ import pytest
 
 import nonsmooth_rod as nr
 from nonsmooth_rod import toys
+from nonsmooth_rod.integrators.scene_plans import forget_plans
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.scenefile import load_scene
 
@@ -27,7 +28,11 @@ def _stepped(monkeypatch, scene, q0, v0, t_end, **opts):
     """The same run with the repetition off (the loop believes the forces change in time)."""
     with monkeypatch.context() as m:
         m.setattr(Scene, "forces_vary_in_time", lambda self: True)
-        return nr.simulate(scene, q0, v0, t_end, **opts)
+        forget_plans()  # a kept plan holds what the unpatched method said (integrators/scene_plans.py)
+        try:
+            return nr.simulate(scene, q0, v0, t_end, **opts)
+        finally:
+            forget_plans()
 
 
 def _assert_same_run(a, b):

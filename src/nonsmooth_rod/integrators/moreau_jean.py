@@ -25,11 +25,11 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
-from ..model.motion import N_NOW_COLUMNS, Prescribed, evaluate_python_motions
+from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, pack_scene
 from ..model.scene import Scene
-from ..results import Event, Impact, Phase, SimulationResult, Trajectory, phases_from_intervals
+from ..results import Event, Impact, Phase, SimulationResult, Status, Trajectory, phases_from_intervals
 from ..solvers.registry import DEFAULT_SOLVER, EXACT_SOLVERS, SOLVER_CODES, SolverName, check_solver_options
 from ..solvers._common import interpreted
 from ..solvers.problem import STATE_OPEN, SolverError
@@ -39,6 +39,7 @@ from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
 from .joint_step import work_size
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
+from .scene_plans import scene_plan
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
 
@@ -106,19 +107,33 @@ def loop_kernels(compiled: bool):
 def _model_and_work(packed, resume: ResumeState | None, driven_origin=None, joints=None):
     """The model and work tuples of moreau_jean_loop; the contact memory from `resume`; `joints`
     the scene's joint table (model.joints.pack_joints; None: no joints)."""
-    n_dof, nc = packed.minv.shape[0], packed.n_contacts
+    model = _model(packed, driven_origin, joints)
+    work = _new_work(packed.n_contacts, packed.minv.shape[0], model.joints)
+    _restore_memory(work, resume)
+    return model, work
+
+
+def _model(packed, driven_origin=None, joints=None):
+    """moreau_jean_loop's Model of a packed scene (its arrays themselves, not copies)."""
     if joints is None:
-        joints = pack_joints((), n_dof // 3)
-    model = loop.Model(packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
-                       packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
-                       packed.pair_keys, packed.pair_contact, *_drive_slots(packed, driven_origin), joints)
-    work = loop.Work(np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
+        joints = pack_joints((), packed.minv.shape[0] // 3)
+    return loop.Model(packed.minv, packed.weight, packed.contacts, packed.contact_index, packed.force_table,
+                      packed.force_index, packed.force_times, packed.force_values, packed.disks, packed.disk_body,
+                      packed.pair_keys, packed.pair_contact, *_drive_slots(packed, driven_origin), joints)
+
+
+def _new_work(nc: int, n_dof: int, joints):
+    """moreau_jean_loop's Work, zeroed: no contact closed, no memory."""
+    return loop.Work(np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
                      np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
                      np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
+
+
+def _restore_memory(work, resume: ResumeState | None) -> None:
+    """The contact memory (closed, grazing, slip signs) of the end state a run resumes from."""
     if resume is not None:
         work[WORK_CLOSED][:], work[WORK_GRAZING][:], work[WORK_SLIP_SIGN][:] = \
             resume.was_closed, resume.grazing, resume.slip_sign
-    return model, work
 
 
 def _drive_slots(packed, driven_origin):
@@ -138,6 +153,43 @@ def driven_start(packed, q0, v0, t0: float):
         origin[r] = q0[3 * body: 3 * body + 3] - d
         v0[3 * body: 3 * body + 3] = w
     return origin, v0
+
+
+WORK_KEY = "work"  # the Work a scene's plan lends to its runs
+
+
+def _run_data(plan, q0, v0, grid: Grid, resume):
+    """(model, work, v0) of a run: the plan's model when the scene has no driven motion (else one
+    with their origins, and v0 with the driven bodies' prescribed velocities), and a zeroed Work
+    lent by the plan or new, with the contact memory of `resume`."""
+    if plan.static:
+        if plan.model is None:
+            plan.model = _model(plan.packed, None, plan.joints)
+        model = plan.model
+    else:
+        origin, v0 = driven_start(plan.packed, q0, v0, float(grid.time(grid.first)))
+        model = _model(plan.packed, origin, plan.joints)
+    work = plan.borrow(WORK_KEY)
+    if work is None:
+        work = _new_work(plan.packed.n_contacts, plan.packed.minv.shape[0], plan.joints)
+    _restore_memory(work, resume)
+    return model, work, v0
+
+
+# A window's records a scene's plan lends to its next run, up to this size (a short run's: zeroing
+# a long window's rows again would cost more than new zeroed pages, and a plan keeps them).
+LENT_WINDOW_BYTES = 1 << 18
+
+
+def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> Window:
+    """The run's window: with the records an earlier run of the scene lent (zeroed), or new."""
+    return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk))
+
+
+def _lend_window(plan, window: Window) -> None:
+    """The window's records back to the scene's plan, for its next run of as many rows, when small."""
+    if sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES:
+        plan.give_back(window.rows, window.out)
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -171,13 +223,10 @@ def compiled_part(solver: str, solver_code, callback: bool):
     the compiled loop."""
     if solver_code is None:
         return "moreau-jean-python-step", "the step kernels around Python solvers", ["--python-step", solver]
-    return "moreau-jean", f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})", []  # callbacks run it step by step
+    return "moreau-jean", _LOOP_IN_WORDS, []  # callbacks run it step by step
 
 
-def _python_motions(packed) -> list:
-    """The packed motions when one of them is a Python (Prescribed) one (each step evaluates
-    them from Python), else []."""
-    return packed.motions if any(isinstance(m, Prescribed) for m in packed.motions) else []
+_LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
 
 
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
@@ -246,21 +295,22 @@ class MoreauJean:
         """From (q0, v0) at t0 (or the end state `resume` of an earlier run) to exactly t_end,
         keeping one sample per `save_every` (default: every step); `stop`: callables (t, q, v)
         tried at each kept sample, ending the run at the first that holds."""
-        opts, names = self.options, [c.name for c in scene.contacts]
+        opts = self.options
         q0, v0 = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)  # checked by the driver
         if opts.tol is not None:
-            return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop, names)
+            return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop,
+                                      [c.name for c in scene.contacts])
         grid = Grid.of(opts.h, t0, t_end, resume)
-        packed = pack_scene(scene)
-        origin, v0 = driven_start(packed, q0, v0, float(grid.time(grid.first)))
-        model, work = _model_and_work(packed, resume, origin, pack_joints(scene.joints, len(scene.bodies)))
-        window = Window(scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
+        plan = scene_plan(scene)  # packed once for the runs that repeat the scene
+        packed, names = plan.packed, list(plan.names)
+        model, work, v0 = _run_data(plan, q0, v0, grid, resume)
+        window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
-        params, iparams = self._parameters(scene, grid, names)
+        params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
         solver_code = SOLVER_CODES.get(opts.solver)
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
-        self._motions_in_python = _python_motions(packed)
+        self._motions_in_python = plan.python_motions
         self._calls_back = scene.applied_force is not None or bool(self._motions_in_python)
         engine = Engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
         self._solver_error = None
@@ -271,7 +321,10 @@ class MoreauJean:
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": engine.compiled and solver_code is not None,
                  "force_callback": self._calls_back}
-        return self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
+        result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
+        plan.give_back(WORK_KEY, work)  # the result keeps copies of what it needs from them
+        _lend_window(plan, window)
+        return result
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
         """The error-controlled run (integrators/adaptive.py) on this integrator's loop and kernels."""
@@ -288,18 +341,21 @@ class MoreauJean:
             return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
                                 model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
 
-    def _parameters(self, scene, grid, names):
+    def _parameters(self, scene, grid, names, varies_in_time=None):
         opts = self.options
+        if varies_in_time is None:
+            varies_in_time = scene.forces_vary_in_time()
         solver_code = SOLVER_CODES.get(opts.solver)
-        solver_options = dict(opts.solver_options)
-        params = np.zeros(loop.N_PARAMS)
-        params[loop.P_H], params[loop.P_THETA], params[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
-        params[loop.P_H_GRID] = opts.h
-        params[loop.P_T0], params[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
+        solver_options = opts.solver_options
+        values = [0.0] * loop.N_PARAMS  # one array from Python floats: cheaper than writing its items
+        values[loop.P_H], values[loop.P_THETA], values[loop.P_GAMMA] = opts.h, opts.theta, opts.activation_gamma
+        values[loop.P_H_GRID] = opts.h
+        values[loop.P_T0], values[loop.P_RTOL] = grid.origin, float(solver_options.get("tol", DEFAULT_RTOL))
+        params = np.array(values, dtype=float)
         iparams = np.array([-1 if solver_code is None else solver_code,
                             int(solver_options.get("max_iter", DEFAULT_MAX_ITER)),
                             names.index(opts.stop_at_impact) if opts.stop_at_impact in names else -1,
-                            int(opts.repeat_rest and not scene.forces_vary_in_time())], dtype=np.int64)
+                            int(opts.repeat_rest and not varies_in_time)], dtype=np.int64)
         return params, iparams
 
     def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops):
@@ -426,26 +482,26 @@ class MoreauJean:
 
     def _ending(self, status, k_end, grid, window, names):
         """(status word, message, solver-failure event or None) of how the run ended at step k_end."""
+        if status == loop.RUN_OK:
+            return Status.OK, f"reached t_end = {grid.t_end:g} s", None
+        if status == loop.RUN_STOPPED:
+            return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
         out = window.out
         q, states, counters = out[0], out[5], out[9]
         t_end = float(grid.time(k_end))
-        if status == loop.RUN_OK:
-            return "ok", f"reached t_end = {grid.t_end:g} s", None
-        if status == loop.RUN_STOPPED:
-            return "ok", f"stopped at the impact of {self.options.stop_at_impact}", None
         if status == loop.RUN_STOPPED_BY_CONDITION:
-            return "stopped", f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
+            return Status.STOPPED, f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
         k = window.k_base + int(counters[loop.K_FAIL_STEP])  # the failing step
         t_k = float(grid.origin + k * grid.h)
         if status == loop.RUN_NONFINITE:
-            return "failed", f"non-finite state at step {k + 1}, t = {float(grid.time(k + 1)):.9g} s", None
+            return Status.FAILED, f"non-finite state at step {k + 1}, t = {float(grid.time(k + 1)):.9g} s", None
         if status == loop.RUN_BAD_GEOMETRY:
             name = names[int(counters[loop.K_FAIL_CONTACT])]
-            return "failed", (f"{name}: disk centres coincide at step {k}, t = {t_k:.9g} s, the contact "
+            return Status.FAILED, (f"{name}: disk centres coincide at step {k}, t = {t_k:.9g} s, the contact "
                               "normal is undefined"), None
         if status == loop.RUN_PASSED_THROUGH:
             name = names[int(counters[loop.K_FAIL_CONTACT])]
-            return "failed", (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
+            return Status.FAILED, (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
                               f"passed through its obstacle within a step; use a smaller h than {grid.h:g} s"), None
         r = k - window.k_base
         state_txt = _states_text(names, states[r - 1] if r else None)
@@ -458,7 +514,7 @@ class MoreauJean:
             message = str(self._solver_error.with_context(where))
         else:
             message = f"{self.options.solver}: {_KERNEL_FAILURES.get(int(counters[loop.K_SOLVER_STATUS]), 'failed')} ({where})"
-        return "failed", message, Event(t_k, "solver-failure", "", {"message": message})
+        return Status.FAILED, message, Event(t_k, "solver-failure", "", {"message": message})
 
     def _impacts(self, scene, grid, collector, names):
         minv = scene.inverse_mass_diagonal
@@ -490,18 +546,17 @@ class MoreauJean:
             phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop)
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
-        n_done = k_end - grid.first
-        stats = dict(stats, steps=n_done, solves=int(counters[loop.K_SOLVES]),
-                     solver_iterations=int(counters[loop.K_ITERATIONS]),
-                     inconsistent_steps=int(counters[loop.K_INCONSISTENT]),
-                     solver_fallbacks=int(counters[loop.K_FALLBACKS]),
-                     steps_at_rest=int(counters[loop.K_REPEATED]))
+        n_done, counts = k_end - grid.first, counters.tolist()
+        stats = dict(stats, steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
+                     inconsistent_steps=counts[loop.K_INCONSISTENT], solver_fallbacks=counts[loop.K_FALLBACKS],
+                     steps_at_rest=counts[loop.K_REPEATED])
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
                                   impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
         result.defer(locate)
         if status == "failed":  # located now: a failed run's contacts may not bear evaluating later
             result._settle()
-        result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
+        if scene.joints:
+            result.joint_forces = joint_forces(scene.joints, collector.joint_force[:collector.n])
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)

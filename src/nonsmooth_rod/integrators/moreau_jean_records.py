@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -106,11 +107,12 @@ class Grid:
         t_before = origin + (first + n - 1) * h
         return cls(origin, first, n - 1, h, t_end - t_before, t_end)
 
-    @property
+    # (computed once: a grid is never changed after Grid.of, and a run reads these a dozen times)
+    @cached_property
     def n_steps(self) -> int:
         return self.n_full + (1 if self.h_last else 0)
 
-    @property
+    @cached_property
     def last(self) -> int:
         return self.first + self.n_steps
 
@@ -127,10 +129,11 @@ class Window:
 
     Row r holds the state at step k_base + r and the records of the step leaving it."""
 
-    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0):
+    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0, out=None):
+        """`out`: zeroed records of this shape lent by an earlier run (integrators/scene_plans.py)."""
         rows = HISTORY + chunk
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
-        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows)
+        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows) if out is None else out
         self.rows, self.k_base, self.r = rows, 0, 0
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
@@ -160,11 +163,11 @@ class Window:
         self.r = keep
 
     def resume_state(self, grid: Grid, work, last_h: float, on_grid: bool) -> ResumeState:
-        keep = min(HISTORY, self.r)
-        lo = self.r - keep
-        return ResumeState(grid.origin if on_grid else grid.t_end, self.k_base + self.r if on_grid else 0, grid.h,
-                           on_grid, last_h, self.out[0][lo: self.r + 1].copy(), self.out[1][lo: self.r + 1].copy(),
-                           *(a[lo: self.r].copy() for a in self.out[2:6]),
+        r, out = self.r, self.out
+        lo = r - min(HISTORY, r)
+        return ResumeState(grid.origin if on_grid else grid.t_end, self.k_base + r if on_grid else 0, grid.h,
+                           on_grid, last_h, out[0][lo: r + 1].copy(), out[1][lo: r + 1].copy(), out[2][lo: r].copy(),
+                           out[3][lo: r].copy(), out[4][lo: r].copy(), out[5][lo: r].copy(),
                            work[WORK_CLOSED].copy(), work[WORK_GRAZING].copy(), work[WORK_SLIP_SIGN].copy())
 
 

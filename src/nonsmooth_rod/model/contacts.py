@@ -131,6 +131,14 @@ class ContactKinematics:
 # dead one whose id was reused. Kept out of the instances so that their __dict__ stays their
 # fields (type(c)(**c.__dict__) copies a relation).
 _PACKED_ROWS: dict = {}
+# Field assignments of any relation so far: a packed scene kept for the runs that repeat it
+# (integrators/scene_plans.py) is packed again when this moved since it was packed.
+_changes = 0
+
+
+def relation_changes() -> int:
+    """How many relation fields have been set in this process (any change of any relation)."""
+    return _changes
 
 
 def _forget_row(ref, key) -> None:
@@ -146,8 +154,10 @@ class _PackedRelation:
     _no_normal = "the contact normal is undefined"
 
     def __setattr__(self, name, value):
+        global _changes
         object.__setattr__(self, name, value)
         _PACKED_ROWS.pop(id(self), None)  # any change of geometry re-packs
+        _changes += 1
 
     def _packed_row(self):
         entry = _PACKED_ROWS.get(id(self))
