@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.dynamics import mode_dynamics
+from ..model.dynamics import ModeDynamics, ModeSystem, lean_mode_dynamics, mode_dynamics
 from ..solvers import available_solvers
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
@@ -70,15 +70,57 @@ class HybridOptions:
         return self.h
 
 
-class _Stage:
-    """The mode's dynamics at one state: its derivative, and what the indicators read."""
+class _Mode:
+    """One segment's mode: the derivative of the state and the indicators' values at any state,
+    from the lean solve (model/dynamics.ModeSystem), or from mode_dynamics where it declines."""
 
-    def __init__(self, scene, modes, t, y):
-        n = scene.n_dof
+    def __init__(self, scene, modes, indicators):
+        self.scene, self.modes, self.indicators = scene, list(modes), indicators
+        self.system = ModeSystem(scene, modes)
+        self.mu_s = [c.law.friction.mu_s for c in scene.contacts]
+
+    def evaluate(self, t: float, y: np.ndarray):
+        """(ẏ, the indicators' values, the mode's (a, N, T) or its ModeDynamics) at (t, y)."""
+        n = self.scene.n_dof
+        lean = self.system.evaluate(t, y)
+        if lean is None:
+            kin = self.scene.kinematics(y[:n], y[n:])
+            dyn = mode_dynamics(self.scene, t, y[:n], y[n:], self.modes, kin)
+            values = _indicator_values(self.scene, self.modes, self.indicators, t, y, kin, dyn)
+            return np.concatenate([y[n:], dyn.a]), values, dyn
+        a, normal, tangential, _, det, gaps, slips = lean
+        values = np.array([self._value(ind, normal, tangential, det, gaps, slips) for ind in self.indicators])
+        return np.concatenate([y[n:], a]), values, (a, normal, tangential)
+
+    def _value(self, ind, normal, tangential, det, gaps, slips) -> float:
+        """One indicator's value, as event_driven._indicator_values gives it (a disk on a line)."""
+        i, kind = ind.contact, ind.kind
+        if kind == "touchdown":
+            value = gaps[i]
+        elif kind == "slip-zero":
+            value = slips[i]
+        elif kind == "liftoff":
+            value = normal[i]
+        elif kind == "painleve":
+            value = det
+        else:
+            value = tangential[i] + (-1.0 if kind == "break-upper" else 1.0) * self.mu_s[i] * normal[i]
+        return value - ind.offset
+
+
+class _Stage:
+    """The mode's dynamics at one state: its derivative, what the indicators read there."""
+
+    def __init__(self, mode: _Mode, t, y):
         self.t, self.y = t, y
-        self.kin = scene.kinematics(y[:n], y[n:])
-        self.dyn = mode_dynamics(scene, t, y[:n], y[n:], modes, self.kin)
-        self.f = np.concatenate([y[n:], self.dyn.a])
+        self.f, self.values, self._dynamics = mode.evaluate(t, y)
+
+    def dynamics(self):
+        """The accelerations and forces for the trajectory's sample (a ModeDynamics' fields)."""
+        if isinstance(self._dynamics, tuple):
+            a, normal, tangential = (np.array(x) for x in self._dynamics)
+            self._dynamics = ModeDynamics(a, normal, tangential, np.zeros((0, 0)), False)
+        return self._dynamics
 
 
 def _hermite(a: _Stage, b: _Stage):
@@ -97,10 +139,17 @@ class _StepWatch(_Watch):
     """The reference's watch (noise bands, near-miss refinement, first fall) fed with a step's
     three samples instead of 13 Chebyshev points."""
 
+    def __init__(self, mode: _Mode, start: _Stage):
+        super().__init__(mode.scene, mode.modes, mode.indicators, start.t, start.y, start=start.values)
+        self.mode = mode
+
     def values(self, stage: _Stage) -> np.ndarray:
         self.evaluations += 1
-        return self.sign * _indicator_values(self.scene, self.modes, self.indicators, stage.t, stage.y,
-                                             stage.kin, stage.dyn)
+        return self.sign * stage.values
+
+    def safe_values(self, t, dense) -> np.ndarray:
+        self.evaluations += 1
+        return self.sign * self.mode.evaluate(t, dense(t))[1]
 
     def first_event_sampled(self, dense, ts, s):
         """(t, j): the first crossing in [ts[0], ts[-1]] given the safe values s (3 × indicators)."""
@@ -180,12 +229,15 @@ class Hybrid(EventDriven):
     def __init__(self, options: HybridOptions | None = None):
         self.options = options or HybridOptions()
 
+    _dynamics = staticmethod(lean_mode_dynamics)  # the reference's decisions, rest and samples
+
     def _segment(self, scene, run, modes, t_end):
         """Steps of h in `modes` from the run's state to the first event or t_end. Returns the
         event's (kind, contact), or None at t_end; leaves the run at the stop."""
         indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
-        start = _Stage(scene, modes, run.t, np.concatenate([run.q, run.v]))
-        watch = _StepWatch(scene, modes, indicators, start.t, start.y)
+        mode = _Mode(scene, modes, indicators)
+        start = _Stage(mode, run.t, np.concatenate([run.q, run.v]))
+        watch = _StepWatch(mode, start)
         s_start, h = watch.values(start), self.options.h
         cap = _first_step_cap(run.boundaries)
         try:
@@ -194,7 +246,7 @@ class Hybrid(EventDriven):
                 if t_end - start.t < 1.01 * step:
                     step = t_end - start.t  # no sliver of a last step
                 cap *= GROWTH
-                middle, end = self._step(scene, modes, start, step, run)
+                middle, end = self._step(mode, start, step, run)
                 run.steps += 1
                 dense = _hermite(start, end)
                 ts = (start.t, middle.t, end.t)
@@ -204,22 +256,22 @@ class Hybrid(EventDriven):
                     run.close(float(hit[0]), dense(hit[0]), modes)
                     return indicators[hit[1]].kind, indicators[hit[1]].contact
                 if end.t >= t_end:
-                    run.close(float(end.t), end.y, modes, end.dyn)
+                    run.close(float(end.t), end.y, modes, end.dynamics())
                     return None
-                run.sample(end.t, end.y, modes, end.dyn)
+                run.sample(end.t, end.y, modes, end.dynamics())
                 start, s_start = end, s_end
         finally:
             run.indicator_evaluations += watch.evaluations
 
-    def _step(self, scene, modes, start: _Stage, h: float, run):
+    def _step(self, mode: _Mode, start: _Stage, h: float, run):
         """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""
         c, a, b, mid = TABLEAUX[self.options.order]
         stages = [start]
         for i in range(1, len(c)):
             y = start.y + h * sum(a_ij * stages[j].f for j, a_ij in enumerate(a[i]) if a_ij)
-            stages.append(_Stage(scene, modes, start.t + c[i] * h, y))
+            stages.append(_Stage(mode, start.t + c[i] * h, y))
         y_end = start.y + h * sum(b_i * st.f for b_i, st in zip(b, stages) if b_i)
-        end = _Stage(scene, modes, start.t + h, y_end)
+        end = _Stage(mode, start.t + h, y_end)
         run.nfev += len(c)
         return stages[mid], end
 

@@ -15,6 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._jit import jit
+from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_NX, C_NY, C_OBSTACLE_VX, C_OBSTACLE_VY,
+                              C_SURFACE_VELOCITY, KIND_DISK_ON_LINE, N_CONTACT_COLUMNS, _on_fixed_normal,
+                              obstacle_velocity)
 from .contacts import ContactKinematics
 from .scene import Scene
 
@@ -132,3 +136,170 @@ def _most_admissible_split(A, lam0, owners, modes, scene):
     if res.status != 0:
         return lam0
     return lam0 + Z @ (scale * res.x[:k])
+
+
+# A contact's mode as the compiled mode solve reads it.
+MODE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
+
+
+class ModeSystem:
+    """`mode_dynamics` for one assignment of modes, set up once and evaluated at many states: the
+    same equations, compiled (`mode_rates_into`). A fixed-step integrator solves its mode
+    thousands of times: mode_dynamics spends ~20 µs a call on numpy's small-array overhead, this
+    ~2 µs on a rod's two contacts.
+
+    For a body's disks and points on fixed lines (the contacts the hybrid method runs) whose
+    constrained system is regular; `evaluate` returns None elsewhere — a statically indeterminate
+    A (two sticking corners of a block at rest), whose split mode_dynamics chooses — and the caller
+    falls back on mode_dynamics."""
+
+    def __init__(self, scene: Scene, modes):
+        self.scene, self.n_dof, self.nc = scene, scene.n_dof, len(scene.contacts)
+        packed = [c._packed_row() for c in scene.contacts]
+        self.usable = all(kind == KIND_DISK_ON_LINE and c.obstacle_motion is None
+                          for (kind, _, _, _), c in zip(packed, scene.contacts))
+        self.table = np.array([row for _, _, _, row in packed], dtype=float).reshape(self.nc, N_CONTACT_COLUMNS)
+        self.table[:, C_MU_D] = [c.law.friction.mu_d for c in scene.contacts]
+        self.ints = np.array([(body, MODE_CODES[mode]) for (_, body, _, _), mode in zip(packed, modes)],
+                             dtype=np.int64).reshape(self.nc, 2)
+        self.minv = scene.inverse_mass_diagonal
+        self.free = scene.inverse_mass_diagonal * scene.weight
+        self.constant = not scene.forces and scene.applied_force is None
+        m = sum({"open": 0, "stick": 2}.get(mode, 1) for mode in modes)
+        self.out = np.empty(self.n_dof + 4 * self.nc + 1 + m * m)
+        self.m = m
+
+    def evaluate(self, t: float, y: np.ndarray):
+        """(a, N, T, A, det A, gaps, slip velocities) at (t, y = (q, v)), lists of floats (A: its
+        rows), or None where mode_dynamics must decide (see the class)."""
+        if not self.usable:
+            return None
+        n, nc, m = self.n_dof, self.nc, self.m
+        free = self.free
+        if not self.constant:
+            free = self.minv * self.scene.force(t, y[:n], y[n:])
+        if not mode_rates_into(self.table, self.ints, self.minv, free, y, self.out):
+            return None
+        out = self.out.tolist()
+        k = n + 4 * nc + 1
+        return (out[:n], out[n:n + nc], out[n + nc:n + 2 * nc], [out[k + m * r:k + m * (r + 1)] for r in range(m)],
+                out[k - 1], out[n + 2 * nc:n + 3 * nc], out[n + 3 * nc:n + 4 * nc])
+
+
+@jit
+def mode_rates_into(table, ints, minv, free, y, out) -> bool:
+    """The mode solve of mode_dynamics for disks on fixed lines (`ModeSystem`): writes a, N, T,
+    the gaps, the slip velocities, det A and A (rows) into out; False where A is singular (the
+    threshold of mode_dynamics), out then incomplete."""
+    n, nc = minv.shape[0], ints.shape[0]
+    q, v = y[:n], y[n:]
+    m = 0
+    for i in range(nc):
+        m += 0 if ints[i, 1] == 0 else (2 if ints[i, 1] == 1 else 1)
+    C, G = np.zeros((m, 3)), np.zeros((m, 3))
+    base, owner, role = np.zeros(m, np.int64), np.zeros(m, np.int64), np.zeros(m, np.int64)
+    M = np.zeros((m, m + 1))
+    hn, ht = np.zeros(6), np.zeros(6)
+    r = 0
+    for i in range(nc):
+        row, body, mode = table[i], ints[i, 0], ints[i, 1]
+        gap, drift_n, drift_t = _on_fixed_normal(row, body, q, v, hn, ht, row[C_NX], row[C_NY], row[C_LINE_PX],
+                                                 row[C_LINE_PY])
+        w_t = obstacle_velocity(hn[0], hn[1], ht[0], ht[1], row[C_OBSTACLE_VX], row[C_OBSTACLE_VY],
+                                row[C_SURFACE_VELOCITY])[1]
+        j = 3 * body
+        out[n + 2 * nc + i] = gap
+        out[n + 3 * nc + i] = ht[0] * v[j] + ht[1] * v[j + 1] + ht[2] * v[j + 2] - w_t
+        if mode == 0:
+            continue
+        s = 0.0 if mode == 1 else (1.0 if mode == 2 else -1.0) * row[C_MU_D]
+        for d in range(3):
+            C[r, d], G[r, d] = hn[d], hn[d] - s * ht[d]
+        base[r], owner[r], role[r], M[r, m] = j, i, 0 if mode == 1 else 2, drift_n
+        r += 1
+        if mode == 1:
+            for d in range(3):
+                C[r, d], G[r, d] = ht[d], ht[d]
+            base[r], owner[r], role[r], M[r, m] = j, i, 1, drift_t
+            r += 1
+    return _solve_mode(C, G, base, owner, role, M, minv, free, table, ints, out)
+
+
+@jit
+def _solve_mode(C, G, base, owner, role, M, minv, free, table, ints, out) -> bool:
+    """A λ = −(Ḣ v + C M⁻¹ f) with A = C M⁻¹ Gᵀ, then a, N, T (mode_rates_into's rows)."""
+    n, nc, m = minv.shape[0], ints.shape[0], C.shape[0]
+    k0 = n + 4 * nc + 1
+    scale = 1.0
+    for r in range(m):
+        j = base[r]
+        M[r, m] = -(M[r, m] + C[r, 0] * free[j] + C[r, 1] * free[j + 1] + C[r, 2] * free[j + 2])
+        for c in range(m):
+            a_rc = 0.0
+            if base[c] == j:
+                a_rc = C[r, 0] * minv[j] * G[c, 0] + C[r, 1] * minv[j + 1] * G[c, 1] + C[r, 2] * minv[j + 2] * G[c, 2]
+            M[r, c] = a_rc
+            out[k0 + m * r + c] = a_rc
+            scale = max(scale, abs(a_rc))
+    det = _eliminate(M)
+    out[k0 - 1] = det
+    if not abs(det) >= 1e-12 * scale ** m:
+        return False
+    for i in range(n):
+        out[i] = free[i]
+    for i in range(nc):
+        out[n + i] = 0.0
+        out[n + nc + i] = 0.0
+    for r in range(m):
+        lam, j, i = M[r, m], base[r], owner[r]
+        for d in range(3):
+            out[j + d] += minv[j + d] * G[r, d] * lam
+        if role[r] == 1:
+            out[n + nc + i] = lam
+        else:
+            out[n + i] = lam
+            if role[r] == 2:
+                sign = 1.0 if ints[i, 1] == 2 else -1.0
+                out[n + nc + i] = -sign * table[i, C_MU_D] * lam
+    return True
+
+
+@jit
+def _eliminate(M) -> float:
+    """Gaussian elimination with partial pivoting of the augmented M = [A | b], in place: the last
+    column becomes x (where A is regular); returns det A."""
+    m = M.shape[0]
+    det = 1.0
+    for k in range(m):
+        p = k
+        for i in range(k + 1, m):
+            if abs(M[i, k]) > abs(M[p, k]):
+                p = i
+        if p != k:
+            for j in range(k, m + 1):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+            det = -det
+        det *= M[k, k]
+        if M[k, k] == 0.0:
+            return 0.0
+        for i in range(k + 1, m):
+            factor = M[i, k] / M[k, k]
+            for j in range(k + 1, m + 1):
+                M[i, j] -= factor * M[k, j]
+    for k in range(m - 1, -1, -1):
+        x = M[k, m]
+        for j in range(k + 1, m):
+            x -= M[k, j] * M[j, m]
+        M[k, m] = x / M[k, k]
+    return det
+
+
+def lean_mode_dynamics(scene: Scene, t: float, q: np.ndarray, v: np.ndarray, modes,
+                       kin: list[ContactKinematics] | None = None) -> ModeDynamics:
+    """mode_dynamics, by the ModeSystem where it applies (the same numbers to round-off)."""
+    lean = ModeSystem(scene, modes).evaluate(t, np.concatenate([q, v]))
+    if lean is None:
+        return mode_dynamics(scene, t, q, v, modes, kin)
+    a, normal, tangential, A = lean[:4]
+    return ModeDynamics(np.array(a), np.array(normal), np.array(tangential),
+                        np.array(A, dtype=float).reshape(len(A), len(A)), False)
