@@ -12,7 +12,7 @@ import pytest
 
 from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import DiskOnLine, Line
-from nonsmooth_rod.model.dynamics import ModeSystem, lean_mode_dynamics, mode_dynamics
+from nonsmooth_rod.model.dynamics import WATCH_CODES, ModeSystem, lean_mode_dynamics, mode_dynamics
 from nonsmooth_rod.model.forces import Spring
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
@@ -31,22 +31,31 @@ def _two_bodies() -> Scene:
 
 
 def _compare(scene, modes, q, v):
-    lean = ModeSystem(scene, modes).evaluate(0.3, np.concatenate([q, v]))
+    watched = [(what, i, 0.01 * i) for i in range(len(scene.contacts)) for what in WATCH_CODES]
+    system = ModeSystem(scene, modes, watched)
+    out = system.evaluate(0.3, np.concatenate([q, v]))
     ref = mode_dynamics(scene, 0.3, q, v, modes)
     if ref.singular:  # two sticking contacts of one body: more unknowns than coordinates
-        assert lean is None
+        assert out is None
         return
-    assert lean is not None
-    a, normal, tangential, A, det = lean[:5]
+    assert out is not None
+    lean = system.dynamics(out)
+    a, normal, tangential, A = lean.a, lean.normal_force, lean.tangential_force, lean.matrix
+    det = out[system.det]
+    np.testing.assert_array_equal(out[system.rates], np.concatenate([v, a]))
     force = float(np.max(np.abs(ref.normal_force)) + np.max(np.abs(scene.force(0.3, q, v))))
     np.testing.assert_allclose(a, ref.a, rtol=0, atol=1e-12 * max(1.0, float(np.max(np.abs(ref.a)))))
     np.testing.assert_allclose(normal, ref.normal_force, rtol=0, atol=1e-12 * force)
     np.testing.assert_allclose(tangential, ref.tangential_force, rtol=0, atol=1e-12 * force)
-    np.testing.assert_allclose(np.reshape(A, ref.matrix.shape), ref.matrix, rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(A, ref.matrix, rtol=1e-14, atol=1e-14)
     assert det == pytest.approx(np.linalg.det(ref.matrix) if ref.matrix.size else 1.0, rel=1e-12)
     kin = scene.kinematics(q, v)
-    np.testing.assert_allclose(lean[5], [k.gap for k in kin], rtol=0, atol=1e-15)
-    np.testing.assert_allclose(lean[6], [k.H_T @ v - k.surface_velocity for k in kin], rtol=0, atol=1e-14)
+    for (what, i, offset), value in zip(watched, out[system.values]):
+        mu_s = scene.contacts[i].law.friction.mu_s
+        expected = {"gap": kin[i].gap, "slip": kin[i].H_T @ v - kin[i].surface_velocity, "normal": ref.normal_force[i],
+                    "upper": ref.tangential_force[i] - mu_s * ref.normal_force[i],
+                    "lower": ref.tangential_force[i] + mu_s * ref.normal_force[i], "det": det}[what]
+        assert value == pytest.approx(expected - offset, rel=0, abs=1e-12 * max(force, 1.0, abs(det)))
 
 
 @pytest.mark.parametrize("modes", list(itertools.product(MODES, repeat=2)))
@@ -75,7 +84,7 @@ def test_a_block_on_two_sticking_corners_is_left_to_mode_dynamics():
     scene = Scene([RigidBody(mass=2.0, inertia=0.1)], corners)
     q, v = np.array([0.0, 0.3, 0.0]), np.zeros(3)
     modes = ["stick", "stick"]
-    assert ModeSystem(scene, modes).evaluate(0.0, np.concatenate([q, v])) is None
+    assert ModeSystem(scene, modes, [("normal", 0, 0.0)]).evaluate(0.0, np.concatenate([q, v])) is None
     lean, ref = lean_mode_dynamics(scene, 0.0, q, v, modes), mode_dynamics(scene, 0.0, q, v, modes)
     assert ref.singular and lean.singular
     np.testing.assert_array_equal(lean.normal_force, ref.normal_force)

@@ -70,57 +70,47 @@ class HybridOptions:
         return self.h
 
 
+# The indicators of event_driven._indicators as the compiled mode solve watches them
+# (model/dynamics.WATCH_CODES); a mode with another (a vertex's region) is solved by mode_dynamics.
+WATCHED_AS = {"touchdown": "gap", "slip-zero": "slip", "liftoff": "normal", "break-upper": "upper",
+              "break-lower": "lower", "painleve": "det"}
+
+
 class _Mode:
     """One segment's mode: the derivative of the state and the indicators' values at any state,
-    from the lean solve (model/dynamics.ModeSystem), or from mode_dynamics where it declines."""
+    from the compiled mode solve (model/dynamics.ModeSystem), or from mode_dynamics and
+    event_driven._indicator_values where it declines."""
 
     def __init__(self, scene, modes, indicators):
         self.scene, self.modes, self.indicators = scene, list(modes), indicators
-        self.system = ModeSystem(scene, modes)
-        self.mu_s = [c.law.friction.mu_s for c in scene.contacts]
+        watched = [(WATCHED_AS.get(ind.kind), ind.contact, ind.offset) for ind in indicators]
+        self.system = ModeSystem(scene, modes, watched) if all(w[0] for w in watched) else None
 
     def evaluate(self, t: float, y: np.ndarray):
-        """(ẏ, the indicators' values, the mode's (a, N, T) or its ModeDynamics) at (t, y)."""
+        """(ẏ, the indicators' values, what the trajectory's sample reads) at (t, y)."""
+        out = self.system.evaluate(t, y) if self.system is not None else None
+        if out is not None:
+            return out[self.system.rates], out[self.system.values], out
         n = self.scene.n_dof
-        lean = self.system.evaluate(t, y)
-        if lean is None:
-            kin = self.scene.kinematics(y[:n], y[n:])
-            dyn = mode_dynamics(self.scene, t, y[:n], y[n:], self.modes, kin)
-            values = _indicator_values(self.scene, self.modes, self.indicators, t, y, kin, dyn)
-            return np.concatenate([y[n:], dyn.a]), values, dyn
-        a, normal, tangential, _, det, gaps, slips = lean
-        values = np.array([self._value(ind, normal, tangential, det, gaps, slips) for ind in self.indicators])
-        return np.concatenate([y[n:], a]), values, (a, normal, tangential)
+        kin = self.scene.kinematics(y[:n], y[n:])
+        dyn = mode_dynamics(self.scene, t, y[:n], y[n:], self.modes, kin)
+        values = _indicator_values(self.scene, self.modes, self.indicators, t, y, kin, dyn)
+        return np.concatenate([y[n:], dyn.a]), values, dyn
 
-    def _value(self, ind, normal, tangential, det, gaps, slips) -> float:
-        """One indicator's value, as event_driven._indicator_values gives it (a disk on a line)."""
-        i, kind = ind.contact, ind.kind
-        if kind == "touchdown":
-            value = gaps[i]
-        elif kind == "slip-zero":
-            value = slips[i]
-        elif kind == "liftoff":
-            value = normal[i]
-        elif kind == "painleve":
-            value = det
-        else:
-            value = tangential[i] + (-1.0 if kind == "break-upper" else 1.0) * self.mu_s[i] * normal[i]
-        return value - ind.offset
+    def dynamics(self, solved) -> ModeDynamics:
+        """The accelerations and forces of an evaluation, for the trajectory's samples."""
+        return solved if isinstance(solved, ModeDynamics) else self.system.dynamics(solved)
 
 
 class _Stage:
     """The mode's dynamics at one state: its derivative, what the indicators read there."""
 
     def __init__(self, mode: _Mode, t, y):
-        self.t, self.y = t, y
-        self.f, self.values, self._dynamics = mode.evaluate(t, y)
+        self.t, self.y, self.mode = t, y, mode
+        self.f, self.values, self._solved = mode.evaluate(t, y)
 
-    def dynamics(self):
-        """The accelerations and forces for the trajectory's sample (a ModeDynamics' fields)."""
-        if isinstance(self._dynamics, tuple):
-            a, normal, tangential = (np.array(x) for x in self._dynamics)
-            self._dynamics = ModeDynamics(a, normal, tangential, np.zeros((0, 0)), False)
-        return self._dynamics
+    def dynamics(self) -> ModeDynamics:
+        return self.mode.dynamics(self._solved)
 
 
 def _hermite(a: _Stage, b: _Stage):
@@ -154,8 +144,7 @@ class _StepWatch(_Watch):
     def first_event_sampled(self, dense, ts, s):
         """(t, j): the first crossing in [ts[0], ts[-1]] given the safe values s (3 × indicators)."""
         found = []
-        for j in range(len(self.indicators)):
-            column = s[:, j].copy()
+        for j, column in enumerate(s.T.tolist()):  # Python floats: the three samples' tests are scalar
             self._start_band(j, ts, column)
             vertex = _parabola_minimum(ts, column)
             dip = vertex is not None and vertex[1] <= DIP_FRACTION * min(column[0], column[-1])
