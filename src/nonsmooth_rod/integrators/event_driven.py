@@ -422,7 +422,7 @@ class EventDriven:
         self.options = options or EventDrivenOptions()
 
     # The modes' dynamics at a state, for the mode decisions, a rest and the samples (the hybrid
-    # method solves them leaner where it can: model/dynamics.lean_mode_dynamics).
+    # method solves them with the compiled model/dynamics.ModeSystem where it can).
     _dynamics = staticmethod(mode_dynamics)
 
     # ------------------------------------------------------------------ mode decisions

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.dynamics import ModeDynamics, ModeSystem, lean_mode_dynamics, mode_dynamics
+from ..model.dynamics import ModeDynamics, ModeSystem, mode_dynamics
 from ..solvers import available_solvers
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
@@ -81,10 +81,10 @@ class _Mode:
     from the compiled mode solve (model/dynamics.ModeSystem), or from mode_dynamics and
     event_driven._indicator_values where it declines."""
 
-    def __init__(self, scene, modes, indicators):
+    def __init__(self, scene, modes, indicators, system_of):
         self.scene, self.modes, self.indicators = scene, list(modes), indicators
-        watched = [(WATCHED_AS.get(ind.kind), ind.contact, ind.offset) for ind in indicators]
-        self.system = ModeSystem(scene, modes, watched) if all(w[0] for w in watched) else None
+        watched = tuple((WATCHED_AS.get(ind.kind), ind.contact, ind.offset) for ind in indicators)
+        self.system = system_of(scene, modes, watched) if all(w[0] for w in watched) else None
 
     def evaluate(self, t: float, y: np.ndarray):
         """(ẏ, the indicators' values, what the trajectory's sample reads) at (t, y)."""
@@ -217,14 +217,30 @@ class Hybrid(EventDriven):
 
     def __init__(self, options: HybridOptions | None = None):
         self.options = options or HybridOptions()
+        self._systems = {}
 
-    _dynamics = staticmethod(lean_mode_dynamics)  # the reference's decisions, rest and samples
+    def run(self, scene, q0, v0, t_end):
+        self._systems = {}  # the compiled mode solves set up in this run, by modes and what they watch
+        return super().run(scene, q0, v0, t_end)
+
+    def _system(self, scene, modes, watched=()) -> ModeSystem:
+        key = (tuple(modes), watched)
+        if key not in self._systems:
+            self._systems[key] = ModeSystem(scene, modes, watched)
+        return self._systems[key]
+
+    def _dynamics(self, scene, t, q, v, modes, kin=None):
+        """The reference's mode decisions, rest and samples by the compiled mode solve, or
+        mode_dynamics where it declines."""
+        system = self._system(scene, modes)
+        out = system.evaluate(t, np.concatenate([q, v]))
+        return mode_dynamics(scene, t, q, v, modes, kin) if out is None else system.dynamics(out)
 
     def _segment(self, scene, run, modes, t_end):
         """Steps of h in `modes` from the run's state to the first event or t_end. Returns the
         event's (kind, contact), or None at t_end; leaves the run at the stop."""
         indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
-        mode = _Mode(scene, modes, indicators)
+        mode = _Mode(scene, modes, indicators, self._system)
         start = _Stage(mode, run.t, np.concatenate([run.q, run.v]))
         watch = _StepWatch(mode, start)
         s_start, h = watch.values(start), self.options.h

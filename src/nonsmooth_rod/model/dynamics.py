@@ -332,11 +332,3 @@ def _eliminate(M) -> float:
             x -= M[k, j] * M[j, m]
         M[k, m] = x / M[k, k]
     return det
-
-
-def lean_mode_dynamics(scene: Scene, t: float, q: np.ndarray, v: np.ndarray, modes,
-                       kin: list[ContactKinematics] | None = None) -> ModeDynamics:
-    """mode_dynamics, by the ModeSystem where it applies (the same numbers to round-off)."""
-    system = ModeSystem(scene, modes)
-    out = system.evaluate(t, np.concatenate([q, v]))
-    return mode_dynamics(scene, t, q, v, modes, kin) if out is None else system.dynamics(out)
