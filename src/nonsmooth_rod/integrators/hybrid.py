@@ -16,6 +16,11 @@ solved for anyway) — and only a sign change, or a dip between them (a parabola
 three with an interior minimum at most half the smaller end value: a grazing peak of T/N inside
 the step), is looked at closely on the step's cubic Hermite interpolant (brentq, or a bounded
 minimisation then brentq). Events are located to the interpolant's accuracy, O(h⁴).
+
+Every mode solve — the stages, the watch's values, the reference's mode decisions, rest test and
+samples (`_dynamics`) — runs through model/dynamics.ModeSystem, mode_dynamics' equations set up
+once per mode and compiled with the indicators' values; mode_dynamics itself where it declines
+(a statically indeterminate A).
 """
 from __future__ import annotations
 

@@ -311,11 +311,15 @@ def _child(spec, ref, time_limit, conn):
 
 
 def _warm_up(specs) -> None:
-    """Compile Moreau–Jean's fast path once here: forked children inherit it, spawned ones load
-    it from numba's on-disk cache instead of compiling it again."""
+    """Compile Moreau–Jean's fast path and the hybrid method's mode solve once here: forked
+    children inherit them, spawned ones load them from numba's on-disk cache instead of
+    compiling them again (within their time limit)."""
+    from .simulation import simulate
+
     if any(s.method == "moreau-jean" for s in specs):
-        from .simulation import simulate
         simulate(RodProblem.paper(2), "moreau-jean", h=1e-2, solver=DEFAULT_SOLVER)
+    if any(s.method == "hybrid" for s in specs):
+        simulate(RodProblem.paper(2), "hybrid", h=5e-2)
 
 
 def run_specs(specs: list[RunSpec], refs: dict, time_limit: float, workers: int = 2,
