@@ -51,7 +51,9 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     """Simulate `scene` from (q0, v0) at time t0 to exactly t_end with the named method.
 
     method: "moreau-jean" (options h, theta, solver, solver_options, activation_gamma,
-    min_phase, fast, tol), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...) or
+    min_phase, fast, tol), "event-driven" (rtol, atol, ode_method, max_step, output_dt, ...),
+    "hybrid" (h, order 2–4: fixed explicit Runge–Kutta steps in each smooth mode, the
+    event-driven reference's events between them; a body's disks and points on fixed lines) or
     "regularized" (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping,
     time_limit, ...): each integrator's options dataclass (its `declares.options`).
     save_every: keep one sample per this many seconds (default: every step / output_dt);

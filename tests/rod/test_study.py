@@ -39,7 +39,7 @@ def test_work_precision_numbers_are_measured_against_the_reference(quick):
     out, _ = quick
     data = read_csv(out / "work_precision.csv")
     rows = [dict(zip(data, vals)) for vals in zip(*data.values())]
-    assert len(rows) == len(study.sweep_specs(quick=True)) == 21
+    assert len(rows) == len(study.sweep_specs(quick=True)) == 24
     assert {r["method"] for r in rows} == set(study.METHOD_NAMES)
     assert {int(r["case"]) for r in rows} == {1, 2, 3}
     by = {(r["method"], r["setting"], int(r["case"]), r["knob"]): r for r in rows}
@@ -53,6 +53,10 @@ def test_work_precision_numbers_are_measured_against_the_reference(quick):
         assert 5 < coarse["impact_error_s"] / fine["impact_error_s"] < 20
         assert fine["impact_error_s"] < 0.5e-3  # within half a step of h = 1e-3
         assert fine["work"] > 300 and fine["cpu_s"] > 0
+        # The hybrid method: fourth order between the reference's events, nine steps of 5e-2 s.
+        hybrid = by[("hybrid", "RK4", case, "h=0.05")]
+        assert hybrid["status"] == "ok" and hybrid["phases_ok"] == "True"
+        assert hybrid["impact_error_s"] < 1e-5 and hybrid["x_O_error_m"] < 1e-5 and hybrid["work"] > 4 * 5
         reg = by[("regularized", "stribeck/LSODA", case, "epsilon=1e-05")]
         assert reg["phases_ok"] == "True" and reg["impact_error_s"] < 5e-4
     # ε = 1e-3 creeps through case 3's stick phase: wrong phases.

@@ -6,6 +6,8 @@ import time
 
 from ..validation import InputError
 
+DEFAULT_METHODS = "event-driven,moreau-jean,hybrid,regularized,switched"
+
 DESCRIPTION = """\
 Run every method over a range of its accuracy knob on the paper's cases and measure it against
 the event-driven solution at rtol 1e-12. Writes DIR/work_precision.png (CPU time against the
@@ -23,8 +25,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("benchmark", help="work–precision chart and stability study of every method",
                               description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--cases", default="1,2,3", help="paper cases, comma-separated (default 1,2,3)")
-    p.add_argument("--methods", default="event-driven,moreau-jean,regularized,switched",
-                   help="methods, comma-separated (default: all four)")
+    p.add_argument("--methods", default=DEFAULT_METHODS, help="methods, comma-separated (default: all five)")
     p.add_argument("--quick", action="store_true", help="a few points per method (about 10 s)")
     p.add_argument("--out", default="benchmark", help="output folder (default ./benchmark)")
     p.add_argument("--time-limit", type=_float, default=None,
@@ -98,7 +99,7 @@ def cmd_benchmark(args) -> int:
                   study.failure_markdown(study.painleve_and_zeno(), study.theta_energy())]
     command = "nonsmooth-rod benchmark" + (" --quick" if args.quick else "") + \
         (f" --cases {args.cases}" if args.cases != "1,2,3" else "") + \
-        (f" --methods {args.methods}" if args.methods != "event-driven,moreau-jean,regularized,switched" else "")
+        (f" --methods {args.methods}" if args.methods != DEFAULT_METHODS else "")
     write_text(out / "stability.md", study.stability_markdown(rows, extras, command))
     n_right = sum(r["right"] for r in rows)
     say(f"{len(rows)} runs ({n_right} right answers) in {time.perf_counter() - wall:.1f} s; files in {out}/: "

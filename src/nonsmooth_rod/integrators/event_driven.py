@@ -218,14 +218,15 @@ def _interior_extrema(coef) -> np.ndarray:
     return np.unique(r[(r > -1.0) & (r < 1.0)])
 
 
-def _noise_levels(scene, modes, indicators, t, y) -> np.ndarray:
-    """Round-off level of each indicator near state y: a thousand ulps of the size of its terms."""
+def _noise_levels(scene, modes, indicators, t, y, start=None) -> np.ndarray:
+    """Round-off level of each indicator near state y: a thousand ulps of the size of its terms
+    (start: the indicators' values at y, when the caller has them)."""
     n = scene.n_dof
     length = float(np.max(np.abs(y[:n]), initial=0.0))
     speed = float(np.max(np.abs(y[n:]), initial=0.0))
     force = _force_scale(scene, t, y[:n], y[n:])
-    start = (_indicator_values(scene, modes, indicators, t, y)
-             if any(ind.kind == "painleve" for ind in indicators) else None)
+    if start is None and any(ind.kind == "painleve" for ind in indicators):
+        start = _indicator_values(scene, modes, indicators, t, y)
     sizes = []
     for j, ind in enumerate(indicators):
         contact = scene.contacts[ind.contact]
@@ -267,10 +268,10 @@ class _Watch:
     leaving the band on the wrong side is an event there.
     """
 
-    def __init__(self, scene, modes, indicators, t0, y0, gap_tol=0.0):
+    def __init__(self, scene, modes, indicators, t0, y0, gap_tol=0.0, start=None):
         self.scene, self.modes, self.indicators, self.t0 = scene, list(modes), indicators, t0
         self.sign = -np.array([ind.direction for ind in indicators], dtype=float)
-        self.noise = _noise_levels(scene, modes, indicators, t0, y0)
+        self.noise = _noise_levels(scene, modes, indicators, t0, y0, start)
         touchdowns = [j for j, ind in enumerate(indicators) if ind.kind == "touchdown"]
         if touchdowns and gap_tol > 0.0:
             # A contact that has just opened starts at the gap its closed phase drifted to (the
@@ -420,6 +421,10 @@ class EventDriven:
     def __init__(self, options: EventDrivenOptions | None = None):
         self.options = options or EventDrivenOptions()
 
+    # The modes' dynamics at a state, for the mode decisions, a rest and the samples (the hybrid
+    # method solves them with the compiled model/dynamics.ModeSystem where it can).
+    _dynamics = staticmethod(mode_dynamics)
+
     # ------------------------------------------------------------------ mode decisions
     def _local(self, scene, q, v):
         kin = scene.kinematics(q, v)
@@ -430,7 +435,7 @@ class EventDriven:
 
     def _consistent(self, scene, t, q, v, modes, kin, u_T, decided):
         """Is this mode assignment consistent at (q, v)? Returns the ModeDynamics or None."""
-        dyn = mode_dynamics(scene, t, q, v, modes, kin)
+        dyn = self._dynamics(scene, t, q, v, modes, kin)
         if not np.all(np.isfinite(dyn.a)):
             return None
         fscale = _force_scale(scene, t, q, v)
@@ -668,7 +673,7 @@ class EventDriven:
         if np.max(np.abs(run.v), initial=0.0) > self.options.velocity_tol:
             return False
         v = np.zeros_like(run.v)
-        dyn = mode_dynamics(scene, run.t, run.q, v, modes)
+        dyn = self._dynamics(scene, run.t, run.q, v, modes)
         a_scale = float(np.max(np.abs(scene.inverse_mass_diagonal * scene.force(run.t, run.q, v))))
         if not np.all(np.abs(dyn.a) <= 1e-12 * a_scale):
             return False
@@ -768,7 +773,7 @@ class EventDriven:
                 a[rows], N[rows], T[rows] = dyn.a, dyn.normal_force, dyn.tangential_force
             else:
                 for k in range(len(bt)):
-                    d = mode_dynamics(scene, bt[k], by[k, :n_dof], by[k, n_dof:], bmodes)
+                    d = self._dynamics(scene, bt[k], by[k, :n_dof], by[k, n_dof:], bmodes)
                     a[row + k], N[row + k], T[row + k] = d.a, d.normal_force, d.tangential_force
             row += len(bt)
         return Trajectory(ts, y[:, :n_dof], y[:, n_dof:], a, N, T, modes)

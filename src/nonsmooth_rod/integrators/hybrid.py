@@ -16,6 +16,11 @@ solved for anyway) — and only a sign change, or a dip between them (a parabola
 three with an interior minimum at most half the smaller end value: a grazing peak of T/N inside
 the step), is looked at closely on the step's cubic Hermite interpolant (brentq, or a bounded
 minimisation then brentq). Events are located to the interpolant's accuracy, O(h⁴).
+
+Every mode solve — the stages, the watch's values, the reference's mode decisions, rest test and
+samples (`_dynamics`) — runs through model/dynamics.ModeSystem, mode_dynamics' equations set up
+once per mode and compiled with the indicators' values; mode_dynamics itself where it declines
+(a statically indeterminate A).
 """
 from __future__ import annotations
 
@@ -24,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.dynamics import mode_dynamics
+from ..model.dynamics import ModeDynamics, ModeSystem, mode_dynamics
 from ..solvers import available_solvers
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
@@ -70,15 +75,47 @@ class HybridOptions:
         return self.h
 
 
-class _Stage:
-    """The mode's dynamics at one state: its derivative, and what the indicators read."""
+# The indicators of event_driven._indicators as the compiled mode solve watches them
+# (model/dynamics.WATCH_CODES); a mode with another (a vertex's region) is solved by mode_dynamics.
+WATCHED_AS = {"touchdown": "gap", "slip-zero": "slip", "liftoff": "normal", "break-upper": "upper",
+              "break-lower": "lower", "painleve": "det"}
 
-    def __init__(self, scene, modes, t, y):
-        n = scene.n_dof
-        self.t, self.y = t, y
-        self.kin = scene.kinematics(y[:n], y[n:])
-        self.dyn = mode_dynamics(scene, t, y[:n], y[n:], modes, self.kin)
-        self.f = np.concatenate([y[n:], self.dyn.a])
+
+class _Mode:
+    """One segment's mode: the derivative of the state and the indicators' values at any state,
+    from the compiled mode solve (model/dynamics.ModeSystem), or from mode_dynamics and
+    event_driven._indicator_values where it declines."""
+
+    def __init__(self, scene, modes, indicators, system_of):
+        self.scene, self.modes, self.indicators = scene, list(modes), indicators
+        watched = tuple((WATCHED_AS.get(ind.kind), ind.contact, ind.offset) for ind in indicators)
+        self.system = system_of(scene, modes, watched) if all(w[0] for w in watched) else None
+
+    def evaluate(self, t: float, y: np.ndarray):
+        """(ẏ, the indicators' values, what the trajectory's sample reads) at (t, y)."""
+        out = self.system.evaluate(t, y) if self.system is not None else None
+        if out is not None:
+            return out[self.system.rates], out[self.system.values], out
+        n = self.scene.n_dof
+        kin = self.scene.kinematics(y[:n], y[n:])
+        dyn = mode_dynamics(self.scene, t, y[:n], y[n:], self.modes, kin)
+        values = _indicator_values(self.scene, self.modes, self.indicators, t, y, kin, dyn)
+        return np.concatenate([y[n:], dyn.a]), values, dyn
+
+    def dynamics(self, solved) -> ModeDynamics:
+        """The accelerations and forces of an evaluation, for the trajectory's samples."""
+        return solved if isinstance(solved, ModeDynamics) else self.system.dynamics(solved)
+
+
+class _Stage:
+    """The mode's dynamics at one state: its derivative, what the indicators read there."""
+
+    def __init__(self, mode: _Mode, t, y):
+        self.t, self.y, self.mode = t, y, mode
+        self.f, self.values, self._solved = mode.evaluate(t, y)
+
+    def dynamics(self) -> ModeDynamics:
+        return self.mode.dynamics(self._solved)
 
 
 def _hermite(a: _Stage, b: _Stage):
@@ -97,16 +134,22 @@ class _StepWatch(_Watch):
     """The reference's watch (noise bands, near-miss refinement, first fall) fed with a step's
     three samples instead of 13 Chebyshev points."""
 
+    def __init__(self, mode: _Mode, start: _Stage):
+        super().__init__(mode.scene, mode.modes, mode.indicators, start.t, start.y, start=start.values)
+        self.mode = mode
+
     def values(self, stage: _Stage) -> np.ndarray:
         self.evaluations += 1
-        return self.sign * _indicator_values(self.scene, self.modes, self.indicators, stage.t, stage.y,
-                                             stage.kin, stage.dyn)
+        return self.sign * stage.values
+
+    def safe_values(self, t, dense) -> np.ndarray:
+        self.evaluations += 1
+        return self.sign * self.mode.evaluate(t, dense(t))[1]
 
     def first_event_sampled(self, dense, ts, s):
         """(t, j): the first crossing in [ts[0], ts[-1]] given the safe values s (3 × indicators)."""
         found = []
-        for j in range(len(self.indicators)):
-            column = s[:, j].copy()
+        for j, column in enumerate(s.T.tolist()):  # Python floats: the three samples' tests are scalar
             self._start_band(j, ts, column)
             vertex = _parabola_minimum(ts, column)
             dip = vertex is not None and vertex[1] <= DIP_FRACTION * min(column[0], column[-1])
@@ -179,13 +222,32 @@ class Hybrid(EventDriven):
 
     def __init__(self, options: HybridOptions | None = None):
         self.options = options or HybridOptions()
+        self._systems = {}
+
+    def run(self, scene, q0, v0, t_end):
+        self._systems = {}  # the compiled mode solves set up in this run, by modes and what they watch
+        return super().run(scene, q0, v0, t_end)
+
+    def _system(self, scene, modes, watched=()) -> ModeSystem:
+        key = (tuple(modes), watched)
+        if key not in self._systems:
+            self._systems[key] = ModeSystem(scene, modes, watched)
+        return self._systems[key]
+
+    def _dynamics(self, scene, t, q, v, modes, kin=None):
+        """The reference's mode decisions, rest and samples by the compiled mode solve, or
+        mode_dynamics where it declines."""
+        system = self._system(scene, modes)
+        out = system.evaluate(t, np.concatenate([q, v]))
+        return mode_dynamics(scene, t, q, v, modes, kin) if out is None else system.dynamics(out)
 
     def _segment(self, scene, run, modes, t_end):
         """Steps of h in `modes` from the run's state to the first event or t_end. Returns the
         event's (kind, contact), or None at t_end; leaves the run at the stop."""
         indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, run.t, run.q, run.v))
-        start = _Stage(scene, modes, run.t, np.concatenate([run.q, run.v]))
-        watch = _StepWatch(scene, modes, indicators, start.t, start.y)
+        mode = _Mode(scene, modes, indicators, self._system)
+        start = _Stage(mode, run.t, np.concatenate([run.q, run.v]))
+        watch = _StepWatch(mode, start)
         s_start, h = watch.values(start), self.options.h
         cap = _first_step_cap(run.boundaries)
         try:
@@ -194,7 +256,7 @@ class Hybrid(EventDriven):
                 if t_end - start.t < 1.01 * step:
                     step = t_end - start.t  # no sliver of a last step
                 cap *= GROWTH
-                middle, end = self._step(scene, modes, start, step, run)
+                middle, end = self._step(mode, start, step, run)
                 run.steps += 1
                 dense = _hermite(start, end)
                 ts = (start.t, middle.t, end.t)
@@ -204,22 +266,22 @@ class Hybrid(EventDriven):
                     run.close(float(hit[0]), dense(hit[0]), modes)
                     return indicators[hit[1]].kind, indicators[hit[1]].contact
                 if end.t >= t_end:
-                    run.close(float(end.t), end.y, modes, end.dyn)
+                    run.close(float(end.t), end.y, modes, end.dynamics())
                     return None
-                run.sample(end.t, end.y, modes, end.dyn)
+                run.sample(end.t, end.y, modes, end.dynamics())
                 start, s_start = end, s_end
         finally:
             run.indicator_evaluations += watch.evaluations
 
-    def _step(self, scene, modes, start: _Stage, h: float, run):
+    def _step(self, mode: _Mode, start: _Stage, h: float, run):
         """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""
         c, a, b, mid = TABLEAUX[self.options.order]
         stages = [start]
         for i in range(1, len(c)):
             y = start.y + h * sum(a_ij * stages[j].f for j, a_ij in enumerate(a[i]) if a_ij)
-            stages.append(_Stage(scene, modes, start.t + c[i] * h, y))
+            stages.append(_Stage(mode, start.t + c[i] * h, y))
         y_end = start.y + h * sum(b_i * st.f for b_i, st in zip(b, stages) if b_i)
-        end = _Stage(scene, modes, start.t + h, y_end)
+        end = _Stage(mode, start.t + h, y_end)
         run.nfev += len(c)
         return stages[mid], end
 

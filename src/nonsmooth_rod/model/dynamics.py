@@ -15,6 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._jit import jit
+from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, C_OBSTACLE_VX, C_OBSTACLE_VY,
+                              C_SURFACE_VELOCITY, KIND_DISK_ON_LINE, N_CONTACT_COLUMNS, _on_fixed_normal,
+                              obstacle_velocity)
 from .contacts import ContactKinematics
 from .scene import Scene
 
@@ -132,3 +136,199 @@ def _most_admissible_split(A, lam0, owners, modes, scene):
     if res.status != 0:
         return lam0
     return lam0 + Z @ (scale * res.x[:k])
+
+
+# A contact's mode as the compiled mode solve reads it.
+MODE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
+# What a mode's switches watch (ModeSystem's `watched`): a contact's gap, slip velocity, N,
+# T − μs N, T + μs N; det A.
+WATCH_CODES = {"gap": 0, "slip": 1, "normal": 2, "upper": 3, "lower": 4, "det": 5}
+
+
+class ModeSystem:
+    """`mode_dynamics` for one assignment of modes, set up once and evaluated at many states: the
+    same equations, compiled (`mode_rates_into`), with the values its switches watch. A
+    fixed-step integrator solves its mode thousands of times: mode_dynamics spends ~20 µs a call
+    on numpy's small-array overhead, this ~3 µs on a rod's two contacts.
+
+    For a body's disks and points on fixed lines (the contacts the hybrid method runs) whose
+    constrained system is regular; `evaluate` returns None elsewhere — a statically indeterminate
+    A (two sticking corners of a block at rest), whose split mode_dynamics chooses — and the caller
+    falls back on mode_dynamics. `watched`: (what, contact, offset) triples, `what` a key of
+    WATCH_CODES; each value is the quantity minus the offset."""
+
+    def __init__(self, scene: Scene, modes, watched=()):
+        n, nc = scene.n_dof, len(scene.contacts)
+        self.scene, self.n_dof = scene, n
+        packed = [c._packed_row() for c in scene.contacts]
+        self.usable = all(kind == KIND_DISK_ON_LINE and c.obstacle_motion is None
+                          for (kind, _, _, _), c in zip(packed, scene.contacts))
+        self.table = np.array([row for _, _, _, row in packed], dtype=float).reshape(nc, N_CONTACT_COLUMNS)
+        self.table[:, C_MU_S] = [c.law.friction.mu_s for c in scene.contacts]
+        self.table[:, C_MU_D] = [c.law.friction.mu_d for c in scene.contacts]
+        self.ints = np.array([(body, MODE_CODES[mode]) for (_, body, _, _), mode in zip(packed, modes)],
+                             dtype=np.int64).reshape(nc, 2)
+        self.watched = np.array([(WATCH_CODES[what], i) for what, i, _ in watched], dtype=np.int64).reshape(-1, 2)
+        self.offsets = np.array([offset for _, _, offset in watched], dtype=float)
+        self.minv = scene.inverse_mass_diagonal
+        self.free = scene.inverse_mass_diagonal * scene.weight
+        self.constant = not scene.forces and scene.applied_force is None
+        m, k = sum({"open": 0, "stick": 2}.get(mode, 1) for mode in modes), len(watched)
+        # out's layout: ẏ = (v, a), the watched values, N, T, det A, A's rows
+        self.rates, self.accelerations, self.values = slice(0, 2 * n), slice(n, 2 * n), slice(2 * n, 2 * n + k)
+        self.normal, self.tangential = slice(2 * n + k, 2 * n + k + nc), slice(2 * n + k + nc, 2 * n + k + 2 * nc)
+        self.det, self.matrix = 2 * n + k + 2 * nc, slice(2 * n + k + 2 * nc + 1, None)
+        self.m, self.out = m, np.empty(2 * n + k + 2 * nc + 1 + m * m)
+
+    def evaluate(self, t: float, y: np.ndarray) -> np.ndarray | None:
+        """A new array in the layout above at (t, y = (q, v)), or None where mode_dynamics must
+        decide (see the class)."""
+        if not self.usable:
+            return None
+        free = self.free
+        if not self.constant:
+            n = self.n_dof
+            free = self.minv * self.scene.force(t, y[:n], y[n:])
+        if not mode_rates_into(self.table, self.ints, self.watched, self.offsets, self.minv, free, y, self.out):
+            return None
+        return self.out.copy()
+
+    def dynamics(self, out: np.ndarray) -> ModeDynamics:
+        """The ModeDynamics of an evaluation."""
+        return ModeDynamics(out[self.accelerations], out[self.normal], out[self.tangential],
+                            out[self.matrix].reshape(self.m, self.m), False)
+
+
+@jit
+def mode_rates_into(table, ints, watched, offsets, minv, free, y, out) -> bool:
+    """The mode solve of mode_dynamics for disks on fixed lines and its watched values
+    (`ModeSystem`, out in its layout); False where A is singular (the threshold of
+    mode_dynamics), out then incomplete."""
+    n, nc = minv.shape[0], ints.shape[0]
+    q, v = y[:n], y[n:]
+    m = 0
+    for i in range(nc):
+        m += 0 if ints[i, 1] == 0 else (2 if ints[i, 1] == 1 else 1)
+    C, G = np.zeros((m, 3)), np.zeros((m, 3))
+    base, owner, role = np.zeros(m, np.int64), np.zeros(m, np.int64), np.zeros(m, np.int64)
+    M = np.zeros((m, m + 1))
+    hn, ht, gaps, slips = np.zeros(6), np.zeros(6), np.zeros(nc), np.zeros(nc)
+    r = 0
+    for i in range(nc):
+        row, body, mode = table[i], ints[i, 0], ints[i, 1]
+        gap, drift_n, drift_t = _on_fixed_normal(row, body, q, v, hn, ht, row[C_NX], row[C_NY], row[C_LINE_PX],
+                                                 row[C_LINE_PY])
+        w_t = obstacle_velocity(hn[0], hn[1], ht[0], ht[1], row[C_OBSTACLE_VX], row[C_OBSTACLE_VY],
+                                row[C_SURFACE_VELOCITY])[1]
+        j = 3 * body
+        gaps[i], slips[i] = gap, ht[0] * v[j] + ht[1] * v[j + 1] + ht[2] * v[j + 2] - w_t
+        if mode == 0:
+            continue
+        s = 0.0 if mode == 1 else (1.0 if mode == 2 else -1.0) * row[C_MU_D]
+        for d in range(3):
+            C[r, d], G[r, d] = hn[d], hn[d] - s * ht[d]
+        base[r], owner[r], role[r], M[r, m] = j, i, 0 if mode == 1 else 2, drift_n
+        r += 1
+        if mode == 1:
+            for d in range(3):
+                C[r, d], G[r, d] = ht[d], ht[d]
+            base[r], owner[r], role[r], M[r, m] = j, i, 1, drift_t
+            r += 1
+    if not _solve_mode(C, G, base, owner, role, M, minv, free, table, ints, out[n:], watched.shape[0]):
+        return False
+    for d in range(n):
+        out[d] = v[d]
+    _watched_values(watched, offsets, table, gaps, slips, out, 2 * n, nc)
+    return True
+
+
+@jit
+def _watched_values(watched, offsets, table, gaps, slips, out, at, nc):
+    """The watched values (WATCH_CODES) into out[at:], from the gaps, slips and out's N, T, det."""
+    k = watched.shape[0]
+    normal, tangential, det = at + k, at + k + nc, out[at + k + 2 * nc]
+    for w in range(k):
+        code, i = watched[w, 0], watched[w, 1]
+        mu_n = table[i, C_MU_S] * out[normal + i]
+        value = det
+        if code == 0:
+            value = gaps[i]
+        elif code == 1:
+            value = slips[i]
+        elif code == 2:
+            value = out[normal + i]
+        elif code == 3:
+            value = out[tangential + i] - mu_n
+        elif code == 4:
+            value = out[tangential + i] + mu_n
+        out[at + w] = value - offsets[w]
+
+
+@jit
+def _solve_mode(C, G, base, owner, role, M, minv, free, table, ints, out, k) -> bool:
+    """A λ = −(Ḣ v + C M⁻¹ f) with A = C M⁻¹ Gᵀ, then out = (a, k values left, N, T, det A, A)
+    (mode_rates_into's rows)."""
+    n, nc, m = minv.shape[0], ints.shape[0], C.shape[0]
+    normal, tangential, at_det = n + k, n + k + nc, n + k + 2 * nc
+    scale = 1.0
+    for r in range(m):
+        j = base[r]
+        M[r, m] = -(M[r, m] + C[r, 0] * free[j] + C[r, 1] * free[j + 1] + C[r, 2] * free[j + 2])
+        for c in range(m):
+            a_rc = 0.0
+            if base[c] == j:
+                a_rc = C[r, 0] * minv[j] * G[c, 0] + C[r, 1] * minv[j + 1] * G[c, 1] + C[r, 2] * minv[j + 2] * G[c, 2]
+            M[r, c] = a_rc
+            out[at_det + 1 + m * r + c] = a_rc
+            scale = max(scale, abs(a_rc))
+    det = _eliminate(M)
+    out[at_det] = det
+    if not abs(det) >= 1e-12 * scale ** m:
+        return False
+    for i in range(n):
+        out[i] = free[i]
+    for i in range(nc):
+        out[normal + i] = 0.0
+        out[tangential + i] = 0.0
+    for r in range(m):
+        lam, j, i = M[r, m], base[r], owner[r]
+        for d in range(3):
+            out[j + d] += minv[j + d] * G[r, d] * lam
+        if role[r] == 1:
+            out[tangential + i] = lam
+        else:
+            out[normal + i] = lam
+            if role[r] == 2:
+                sign = 1.0 if ints[i, 1] == 2 else -1.0
+                out[tangential + i] = -sign * table[i, C_MU_D] * lam
+    return True
+
+
+@jit
+def _eliminate(M) -> float:
+    """Gaussian elimination with partial pivoting of the augmented M = [A | b], in place: the last
+    column becomes x (where A is regular); returns det A."""
+    m = M.shape[0]
+    det = 1.0
+    for k in range(m):
+        p = k
+        for i in range(k + 1, m):
+            if abs(M[i, k]) > abs(M[p, k]):
+                p = i
+        if p != k:
+            for j in range(k, m + 1):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+            det = -det
+        det *= M[k, k]
+        if M[k, k] == 0.0:
+            return 0.0
+        for i in range(k + 1, m):
+            factor = M[i, k] / M[k, k]
+            for j in range(k + 1, m + 1):
+                M[i, j] -= factor * M[k, j]
+    for k in range(m - 1, -1, -1):
+        x = M[k, m]
+        for j in range(k + 1, m):
+            x -= M[k, j] * M[j, m]
+        M[k, m] = x / M[k, k]
+    return det

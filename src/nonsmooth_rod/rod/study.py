@@ -1,8 +1,9 @@
 """Speed against accuracy: the work–precision study, the stability study and the failure modes.
 
 Every method runs the paper's three cases over a range of its accuracy knob (event-driven: rtol;
-Moreau–Jean: h, per one-step solver; regularized: the regularisation velocity ε, per friction
-curve and ODE method; switched: h of RK4 or rtol of an adaptive method). Each run is measured
+Moreau–Jean: h, per one-step solver, or its error control's tol; hybrid: h of its Runge–Kutta
+steps of order 4 between events; regularized: the regularisation velocity ε, per friction curve
+and ODE method; switched: h of RK4 or rtol of an adaptive method). Each run is measured
 against the event-driven solution at rtol = 1e-12 (the reference):
 
 * impact_error_s — |t_B − t_B,ref|, the time of ball B's impact;
@@ -10,7 +11,7 @@ against the event-driven solution at rtol = 1e-12 (the reference):
   impacts (the reference interpolated by cubic Hermite on its 1e-4 s samples);
 * phases_ok — the same sequence of ball A's modes, every boundary within PHASE_TOLERANCE;
 * cpu_s — the integrator's own CPU time; work — right-hand-side evaluations (event-driven,
-  regularized, switched) or steps (Moreau–Jean).
+  hybrid, regularized, switched) or steps (Moreau–Jean).
 
 The stability verdict of a run lists why it is not a right answer: its status (time limit,
 step-size collapse, NaN, penetration, Painlevé, Zeno, solver failure, no impact), a wrong phase
@@ -40,7 +41,7 @@ PHASE_TOLERANCE = 2e-3  # s: a phase boundary further off than this makes the ph
 CREEP_BOUND = 1e-4  # m: slip of the contact point during a reference stick phase (0.1 mm)
 PENETRATION_BOUND = 1e-4  # m: ADAMS's default penetration depth is 0.1 mm
 ENERGY_TOLERANCE = 1e-3  # relative to M g ξ sin θ0, the energy the fall releases
-METHOD_NAMES = ("event-driven", "moreau-jean", "regularized", "switched")
+METHOD_NAMES = ("event-driven", "moreau-jean", "hybrid", "regularized", "switched")
 CSV_COLUMNS = ("method", "setting", "case", "knob", "cpu_s", "work", "impact_error_s", "x_O_error_m",
                "phases_ok", "status")
 STABILITY_COLUMNS = ("method", "setting", "case", "knob", "finished", "right", "reasons", "status",
@@ -89,6 +90,8 @@ FULL_SWEEPS = (
     Sweep("moreau-jean", "osqp", "h", (1e-2, 3e-3, 1e-3, 3e-4), (("solver", "osqp"),)),
     # error control (integrators/adaptive.py): the step sizes chosen for each tolerance
     Sweep("moreau-jean", f"{DEFAULT_SOLVER}, tol", "tol", (1e-3, 1e-4, 1e-5, 1e-6), (("solver", DEFAULT_SOLVER),)),
+    # Runge–Kutta of order 4 in each smooth mode, the reference's events (integrators/hybrid.py)
+    Sweep("hybrid", "RK4", "h", (1e-1, 5e-2, 2e-2, 1e-2), (("order", 4),)),
     *(Sweep("regularized", f"stribeck/{ode}", "epsilon", (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6),
             (("friction_curve", "stribeck"), ("ode_method", ode), ("rtol", REGULARIZED_RTOL)))
       for ode in ("RK45", "DOP853", "Radau", "BDF", "LSODA")),
@@ -102,6 +105,7 @@ FULL_SWEEPS = (
 QUICK_SWEEPS = (
     Sweep("event-driven", "DOP853", "rtol", (1e-4, 1e-8)),
     Sweep("moreau-jean", DEFAULT_SOLVER, "h", (1e-2, 1e-3), (("solver", DEFAULT_SOLVER),)),
+    Sweep("hybrid", "RK4", "h", (5e-2,), (("order", 4),)),
     Sweep("regularized", "stribeck/LSODA", "epsilon", (1e-3, 1e-5),
           (("friction_curve", "stribeck"), ("ode_method", "LSODA"), ("rtol", REGULARIZED_RTOL))),
     Sweep("switched", "rk4", "h", (1e-3,), (("ode_method", "rk4"),)),
@@ -307,11 +311,15 @@ def _child(spec, ref, time_limit, conn):
 
 
 def _warm_up(specs) -> None:
-    """Compile Moreau–Jean's fast path once here: forked children inherit it, spawned ones load
-    it from numba's on-disk cache instead of compiling it again."""
+    """Compile Moreau–Jean's fast path and the hybrid method's mode solve once here: forked
+    children inherit them, spawned ones load them from numba's on-disk cache instead of
+    compiling them again (within their time limit)."""
+    from .simulation import simulate
+
     if any(s.method == "moreau-jean" for s in specs):
-        from .simulation import simulate
         simulate(RodProblem.paper(2), "moreau-jean", h=1e-2, solver=DEFAULT_SOLVER)
+    if any(s.method == "hybrid" for s in specs):
+        simulate(RodProblem.paper(2), "hybrid", h=5e-2)
 
 
 def run_specs(specs: list[RunSpec], refs: dict, time_limit: float, workers: int = 2,
@@ -439,8 +447,8 @@ def plot_work_precision(records: list[dict], path) -> None:
     palettes = {"event-driven": ["black"],
                 "moreau-jean": ["#08306b", "#17becf", "#6baed6", "#393b79", "#fd8d3c"],
                 "regularized": ["#d62728", "#ff7f0e", "#8c564b", "#e377c2", "#9467bd", "#bcbd22", "#7f0000"],
-                "switched": ["#2ca02c", "#74c476"]}
-    styles = {"event-driven": "-", "moreau-jean": "-", "regularized": "--", "switched": ":"}
+                "switched": ["#2ca02c", "#74c476"], "hybrid": ["#6a3d9a"]}
+    styles = {"event-driven": "-", "moreau-jean": "-", "hybrid": "-.", "regularized": "--", "switched": ":"}
     markers = ["o", "s", "^", "D", "v", "P", "X"]
     groups: dict[tuple, dict] = {}
     for r in records:

@@ -1,0 +1,90 @@
+"""The mode solve set up once (ModeSystem, compiled) against mode_dynamics, the reference's:
+the same accelerations, forces and constrained matrix to round-off for every mode of a rod on
+two balls and of two bodies on two lines (one of them moving as a belt, one under a spring);
+None where A is statically indeterminate (a block resting on two sticking corners), so that
+the caller falls back on mode_dynamics' choice of split. The hybrid method, which runs it, is
+checked against the event-driven reference in tests/integrators/test_hybrid.py."""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from nonsmooth_rod.model.body import RigidBody
+from nonsmooth_rod.model.contacts import DiskOnLine, Line
+from nonsmooth_rod.model.dynamics import WATCH_CODES, ModeSystem, mode_dynamics
+from nonsmooth_rod.model.forces import Spring
+from nonsmooth_rod.model.laws import ContactLaw
+from nonsmooth_rod.model.scene import Scene
+from nonsmooth_rod.rod.problem import RodProblem
+
+MODES = ("open", "stick", "slip+", "slip-")
+
+
+def _two_bodies() -> Scene:
+    law = ContactLaw.of(mu_s=0.4, mu_d=0.3)
+    floor, belt = Line(), Line(point=(0.0, 0.1), angle=-0.6, velocity=0.7)
+    bodies = [RigidBody(mass=1.3, inertia=0.02), RigidBody(mass=0.7, inertia=0.05)]
+    contacts = [DiskOnLine(0, (0.1, -0.05), floor, radius=0.03, law=law, name="a"),
+                DiskOnLine(1, (-0.2, 0.1), belt, radius=0.0, law=law, name="b")]
+    return Scene(bodies, contacts, forces=[Spring(0, (0.0, 0.0), 1, (0.05, 0.0), stiffness=40.0, rest_length=0.3)])
+
+
+def _compare(scene, modes, q, v):
+    watched = [(what, i, 0.01 * i) for i in range(len(scene.contacts)) for what in WATCH_CODES]
+    system = ModeSystem(scene, modes, watched)
+    out = system.evaluate(0.3, np.concatenate([q, v]))
+    ref = mode_dynamics(scene, 0.3, q, v, modes)
+    if ref.singular:  # two sticking contacts of one body: more unknowns than coordinates
+        assert out is None
+        return
+    assert out is not None
+    lean = system.dynamics(out)
+    a, normal, tangential, A = lean.a, lean.normal_force, lean.tangential_force, lean.matrix
+    det = out[system.det]
+    np.testing.assert_array_equal(out[system.rates], np.concatenate([v, a]))
+    force = float(np.max(np.abs(ref.normal_force)) + np.max(np.abs(scene.force(0.3, q, v))))
+    np.testing.assert_allclose(a, ref.a, rtol=0, atol=1e-12 * max(1.0, float(np.max(np.abs(ref.a)))))
+    np.testing.assert_allclose(normal, ref.normal_force, rtol=0, atol=1e-12 * force)
+    np.testing.assert_allclose(tangential, ref.tangential_force, rtol=0, atol=1e-12 * force)
+    np.testing.assert_allclose(A, ref.matrix, rtol=1e-14, atol=1e-14)
+    assert det == pytest.approx(np.linalg.det(ref.matrix) if ref.matrix.size else 1.0, rel=1e-12)
+    kin = scene.kinematics(q, v)
+    for (what, i, offset), value in zip(watched, out[system.values]):
+        mu_s = scene.contacts[i].law.friction.mu_s
+        expected = {"gap": kin[i].gap, "slip": kin[i].H_T @ v - kin[i].surface_velocity, "normal": ref.normal_force[i],
+                    "upper": ref.tangential_force[i] - mu_s * ref.normal_force[i],
+                    "lower": ref.tangential_force[i] + mu_s * ref.normal_force[i], "det": det}[what]
+        assert value == pytest.approx(expected - offset, rel=0, abs=1e-12 * max(force, 1.0, abs(det)))
+
+
+@pytest.mark.parametrize("modes", list(itertools.product(MODES, repeat=2)))
+def test_every_mode_of_the_rod_as_mode_dynamics(modes):
+    problem = RodProblem.paper(2)
+    scene = problem.scene()
+    q0, v0 = problem.initial_state()
+    rng = np.random.default_rng(len(modes[0]) + 7 * len(modes[1]))
+    for _ in range(5):
+        _compare(scene, list(modes), q0 + 0.05 * rng.standard_normal(3), v0 + rng.standard_normal(3))
+
+
+@pytest.mark.parametrize("modes", list(itertools.product(MODES, repeat=2)))
+def test_two_bodies_a_belt_and_a_spring_as_mode_dynamics(modes):
+    scene = _two_bodies()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = np.array([0.0, 0.08, 0.3, 0.4, 0.2, -0.4]) + 0.02 * rng.standard_normal(6)
+        _compare(scene, list(modes), q, rng.standard_normal(6))
+
+
+def test_a_block_on_two_sticking_corners_is_left_to_mode_dynamics():
+    """Four unknowns for three degrees of freedom: A is singular, the split is mode_dynamics'."""
+    law = ContactLaw.of(mu_s=0.5, mu_d=0.4)
+    corners = [DiskOnLine(0, (x, -0.3), Line(), law=law, name=name) for x, name in ((-0.2, "left"), (0.2, "right"))]
+    scene = Scene([RigidBody(mass=2.0, inertia=0.1)], corners)
+    q, v = np.array([0.0, 0.3, 0.0]), np.zeros(3)
+    modes = ["stick", "stick"]
+    assert ModeSystem(scene, modes, [("normal", 0, 0.0)]).evaluate(0.0, np.concatenate([q, v])) is None
+    assert mode_dynamics(scene, 0.0, q, v, modes).singular
+    assert ModeSystem(scene, ["stick", "open"]).evaluate(0.0, np.concatenate([q, v])) is not None
