@@ -403,13 +403,13 @@ class _Run:
         ts, ys = np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(y)
         keep = self.thinning.keeps(ts)
         self.unkept = None if keep[-1] else (ts[-1:], ys[-1:].copy(), list(modes), dynamics)
-        ts, ys = ts[keep], ys[keep]
+        ts, ys = ts[keep], ys[keep]  # copies (a mask)
         n = ys.shape[1] // 2
-        stop = self.thinning.first_stop(ts, ys[:, :n], ys[:, n:])
+        stop = self.thinning.first_stop(ts, ys[:, :n].copy(), ys[:, n:].copy())
         if stop is not None:
             ts, ys, self.unkept = ts[: stop + 1], ys[: stop + 1], None
         if ts.size:
-            self.samples.append((ts, ys.copy(), list(modes), dynamics))
+            self.samples.append((ts, ys, list(modes), dynamics))
         if stop is not None:
             self._end_segment(float(ts[-1]), ys[-1], modes)
             raise _Stop("stopped", stop_message(self.t), event=stop_event(self.t))

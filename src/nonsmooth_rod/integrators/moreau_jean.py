@@ -38,7 +38,7 @@ from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
 from .joint_step import work_size
-from .sampling import stop_event, stop_holds, stop_message, thinned_count
+from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
@@ -359,11 +359,11 @@ class MoreauJean:
 
     def _first_hold(self, stops, collector, window, k_from, k_to):
         """The first kept step in (k_from, k_to] where a stop condition holds, or None."""
-        for k in kept_steps(collector.grid, k_from + 1, k_to, collector.save_every):
-            r = k - window.k_base
-            if k > k_from and stop_holds(stops, collector.grid.time(k), window.out[0][r], window.out[1][r]):
-                return int(k)
-        return None
+        ks = kept_steps(collector.grid, k_from + 1, k_to, collector.save_every)
+        ks = ks[ks > k_from]
+        rows = ks - window.k_base  # q, v rows copied (fancy indexing): the conditions' own
+        held = first_hold(stops, collector.grid.time(ks), window.out[0][rows], window.out[1][rows])
+        return None if held is None else int(ks[held])
 
     def _run_stepwise(self, kernels, scene, r_start, r_end, params, iparams, model, work, out):
         """The loop step by step from Python: for a Python `applied_force` (called back for each

@@ -312,7 +312,7 @@ class Regularized:
         solver = ODE_METHODS[o.ode_method](self._rhs, rec.t0, y, t_end, **kwargs)
         rec.samples_t, rec.samples_y = [rec.t0], [y.copy()]
         thinning.keeps(rec.t0)
-        if thinning.first_stop([rec.t0], [y[:n]], [y[n:]]) is not None:
+        if thinning.first_stop([rec.t0], [y[:n].copy()], [y[n:].copy()]) is not None:
             rec.t_stop, rec.status, rec.message = rec.t0, "stopped", stop_message(rec.t0)
         rec.local = [c.local(y, n) for c in self._contacts]
         states = [self._state_of(g, u) for g, _, u, _, _ in rec.local]
@@ -377,7 +377,7 @@ class Regularized:
             y = dense()(t)
             rec.samples_t.append(float(t))
             rec.samples_y.append(y)
-            if rec.thinning.first_stop([t], [y[:n]], [y[n:]]) is not None:
+            if rec.thinning.first_stop([t], [y[:n].copy()], [y[n:].copy()]) is not None:
                 return float(t)
         return None
 

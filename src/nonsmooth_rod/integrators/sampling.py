@@ -35,6 +35,21 @@ def stop_holds(stops, t, q, v) -> bool:
     return any(bool(cond(float(t), q.copy(), v.copy())) for cond in stops)
 
 
+def first_hold(stops, ts, qs, vs) -> int | None:
+    """The index of the first sample (ts[k], qs[k], vs[k]) where a stop condition holds, or None.
+    qs, vs: the caller's copies (a condition may write into its rows: not the run's state), so
+    that a sample costs a condition's call and nothing more (a compiled step can cost less)."""
+    if not stops:
+        return None
+    times = [float(t) for t in ts]
+    for k in range(len(times)):
+        t, q, v = times[k], qs[k], vs[k]
+        for cond in stops:
+            if cond(t, q, v):
+                return k
+    return None
+
+
 def stop_message(t: float) -> str:
     return f"a stop condition held at t = {t:.9g} s"
 
@@ -70,12 +85,8 @@ class Thinning:
         return keep
 
     def first_stop(self, ts, qs, vs) -> int | None:
-        if not self.stops:
-            return None
-        for k in range(len(ts)):
-            if stop_holds(self.stops, ts[k], qs[k], vs[k]):
-                return k
-        return None
+        """`first_hold` with this run's stop conditions (qs, vs: the caller's copies)."""
+        return first_hold(self.stops, ts, qs, vs)
 
 
 def grid_blocks(t0: float, dt: float, a: float, b: float, block: int = 1 << 14):
@@ -91,5 +102,5 @@ def grid_blocks(t0: float, dt: float, a: float, b: float, block: int = 1 << 14):
         k += block
 
 
-__all__ = ["Thinning", "save_slots", "thinned_count", "stop_holds", "stop_message", "stop_event", "grid_blocks",
+__all__ = ["Thinning", "save_slots", "thinned_count", "stop_holds", "first_hold", "stop_message", "stop_event", "grid_blocks",
            "SLOT_TOL"]
