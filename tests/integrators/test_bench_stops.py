@@ -4,7 +4,6 @@ at the first sample past the dropped ball's closed-form fall time."""
 import importlib.util
 from pathlib import Path
 
-import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 
