@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -20,7 +19,7 @@ import numpy as np
 from . import _jit
 from .integrators import METHODS, MAX_OUTPUT_BYTES, check_output_size, integrator_class
 from .model.scene import Scene
-from .results import Event, SimulationResult, Status, Trajectory
+from .results import SimulationResult
 from .validation import InputError, quoted, require_finite, require_positive, require_state
 
 
@@ -56,11 +55,11 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     event-driven reference's events between them; a body's disks and points on fixed lines) or
     "regularized" (epsilon, friction_curve, ode_method, rtol, atol, stiffness, damping,
     time_limit, ...): each integrator's options dataclass (its `declares.options`).
-    save_every: keep one sample per this many seconds (default: every step / output_dt);
-    Moreau–Jean thins while it runs, so memory follows what is kept.
+    save_every: keep one sample per this many seconds (default: every step / output_dt); every
+    method thins while it runs, so memory follows what is kept.
     stop: a contact name or `StopAtImpact(name)` (the run ends at that contact's first
-    impact), a callable (t, q, v) -> bool (the run ends at the first saved sample where it is
-    true, status "stopped"; Moreau–Jean tries it while it runs), or a list of these.
+    impact), a callable (t, q, v) -> bool (tried at each kept sample while the run goes: it
+    ends at the first where one is true, status "stopped"), or a list of these.
     resume: the `end_state` of an earlier Moreau–Jean result (what its next step reads: contact
     memory, warm starts, the step grid): the run goes on exactly as the earlier one would have;
     `result.restart(t_end)` passes it.
@@ -91,28 +90,12 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
             raise InputError(f"resume: only a Moreau–Jean run continues from an end state; method "
                              f"{method!r} restarts from (q0, v0)")
         declared.resumes(resume, scene, q0, v0)
-    result = _run(integrator_cls(opts), declared.absolute_time, scene, q0, v0, t0, t_end, save_every, callables,
-                  resume)
+    # On the scene's clock; each method keeps one sample per save_every and tries the stop
+    # conditions at them while it runs (integrators/sampling.py).
+    result = integrator_cls(opts).run(scene, q0, v0, t_end, t0=t0, resume=resume, save_every=save_every,
+                                      stop=callables)
     result.method = method
     result.setup = RunSetup(scene, method, dict(options), stop, save_every, q0, v0, t0, t_end)
-    return result
-
-
-def _run(integrator, absolute_time: bool, scene, q0, v0, t0, t_end, save_every, callables,
-         resume) -> SimulationResult:
-    """The integrator's run: on the scene's own clock with the stops and thinning inside the run
-    where it declares so (`absolute_time`); otherwise from 0 on a shifted scene, stops and
-    thinning after."""
-    if absolute_time:
-        return integrator.run(scene, q0, v0, t_end, t0=t0, resume=resume, save_every=save_every, stop=callables)
-    result = integrator.run(_shifted(scene, t0), q0, v0, t_end - t0)
-    if t0:
-        _shift_times(result, t0)
-    if callables:
-        _apply_stop(result, callables)
-    if save_every is not None:
-        _decimate(result, save_every)
-    result.end_state = None  # restarted from (q, v): these methods decide their modes afresh
     return result
 
 
@@ -227,90 +210,6 @@ def _checked_options(options_cls, method: str, options: dict, impact_stops: list
         raise
     except (TypeError, ValueError) as err:
         raise InputError(f"invalid option for method {method!r}: {err}") from None
-
-
-def _shifted(scene: Scene, t0: float) -> Scene:
-    """The scene with its time-dependent forces read at t0 + t (integrators start at 0)."""
-    if not t0:
-        return scene
-    forces = [_force_shifted(force, t0) for force in scene.forces]
-    applied = scene.applied_force
-    if applied is not None:
-        def applied_at_absolute_time(t, q, v):
-            return applied(t + t0, q, v)
-    return dataclasses.replace(scene, forces=forces,
-                               applied_force=None if applied is None else applied_at_absolute_time)
-
-
-def _force_shifted(force, t0: float):
-    """A force data object whose clock starts at t0 (ramps and tables move back by t0)."""
-    if hasattr(force, "t_start") and hasattr(force, "t_full"):
-        return dataclasses.replace(force, t_start=force.t_start - t0, t_full=force.t_full - t0)
-    if hasattr(force, "times"):
-        return dataclasses.replace(force, times=tuple(t - t0 for t in force.times))
-    return force
-
-
-_TIME_IN_MESSAGE = re.compile(r"\b(t|t_end) = ([-+0-9.eE]+) s\b")
-
-
-def _shifted_time(match, t0: float) -> str:
-    try:
-        return f"{match[1]} = {float(match[2]) + t0:.12g} s"
-    except ValueError:
-        return match[0]
-
-
-def _shift_times(result: SimulationResult, t0: float) -> None:
-    result.trajectory.t = result.trajectory.t + t0
-    # The integrators ran on a clock starting at 0: their messages' "t = … s" too.
-    result.message = _TIME_IN_MESSAGE.sub(lambda m: _shifted_time(m, t0), result.message)
-    for event in result.events:
-        event.t += t0
-    for impact in result.impacts:
-        impact.t += t0
-    for phases in result.phases.values():
-        for phase in phases:
-            phase.t_start += t0
-            phase.t_end += t0
-
-
-def _apply_stop(result: SimulationResult, conditions) -> None:
-    """End the result at the first sample where any condition holds."""
-    tr = result.trajectory
-    for k in range(len(tr.t)):
-        if any(bool(cond(float(tr.t[k]), tr.q[k].copy(), tr.v[k].copy())) for cond in conditions):
-            t_stop = float(tr.t[k])
-            _truncate(result, k + 1)
-            result.events.append(Event(t_stop, "stop", "", {}))
-            result.set_status(Status.STOPPED, f"a stop condition held at t = {t_stop:.9g} s")
-            return
-
-
-def _truncate(result: SimulationResult, n: int) -> None:
-    tr = result.trajectory
-    t_last = float(tr.t[n - 1])
-    result.trajectory = Trajectory(tr.t[:n], tr.q[:n], tr.v[:n], tr.a[:n], tr.normal_force[:n],
-                                   tr.tangential_force[:n], tr.modes[:n])
-    result.events = [e for e in result.events if e.t <= t_last]
-    result.impacts = [i for i in result.impacts if i.t <= t_last]
-    for name, phases in result.phases.items():
-        kept = [p for p in phases if p.t_start < t_last]
-        if kept:
-            kept[-1].t_end = min(kept[-1].t_end, t_last)
-        result.phases[name] = kept
-
-
-def _decimate(result: SimulationResult, save_every: float) -> None:
-    """Keep the first sample, then one per `save_every` seconds, and the last one."""
-    tr = result.trajectory
-    if len(tr.t) < 3:
-        return
-    slots = np.floor((tr.t - tr.t[0]) / save_every + 1e-9)
-    keep = np.r_[True, slots[1:] != slots[:-1]]
-    keep[-1] = True
-    result.trajectory = Trajectory(tr.t[keep], tr.q[keep], tr.v[keep], tr.a[keep], tr.normal_force[keep],
-                                   tr.tangential_force[keep], tr.modes[keep])
 
 
 __all__ = ["simulate", "StopAtImpact", "RunSetup", "MAX_OUTPUT_BYTES"]

@@ -1,6 +1,7 @@
 """Integrators declare what they run (integrators/declaration.py) and the driver checks a run from
-that alone: a method the driver has never heard of runs through nr.simulate — shifted clock,
-stop condition, thinning, refusals and the memory check — from its declaration."""
+that alone: a method the driver has never heard of runs through nr.simulate — the scene's clock,
+stop condition, thinning (integrators/sampling.py), refusals and the memory check — from its
+declaration."""
 import ast
 import math
 from dataclasses import dataclass
@@ -12,6 +13,7 @@ import pytest
 import nonsmooth_rod as nr
 from nonsmooth_rod import integrators
 from nonsmooth_rod.integrators.declaration import NO_JOINTS, Declaration, Refusal
+from nonsmooth_rod.integrators.sampling import Thinning, stop_message
 from nonsmooth_rod.results import SimulationResult, Trajectory
 
 G = 9.81
@@ -31,15 +33,24 @@ class Flight:
     def __init__(self, options):
         self.options = options
 
-    def run(self, scene, q0, v0, t_end):
-        t = np.r_[np.arange(0.0, t_end, self.options.output_dt), t_end]
+    def run(self, scene, q0, v0, t_end, *, t0=0.0, resume=None, save_every=None, stop=()):
+        t = np.r_[np.arange(t0, t_end, self.options.output_dt), t_end]
+        thinning = Thinning(t0, save_every, stop)
+        keep = thinning.keeps(t)
+        keep[-1] = True
+        t = t[keep]
         g = np.tile(np.array(scene.gravity_vector + (0.0,)), len(scene.bodies))
-        q = q0 + np.outer(t, v0) + 0.5 * np.outer(t**2, g)
-        v = v0 + np.outer(t, g)
+        q = q0 + np.outer(t - t0, v0) + 0.5 * np.outer((t - t0) ** 2, g)
+        v = v0 + np.outer(t - t0, g)
+        held = thinning.first_stop(t, q, v)
+        status = "ok" if held is None else "stopped"
+        if held is not None:
+            t, q, v = t[: held + 1], q[: held + 1], v[: held + 1]
         n, nc = len(t), len(scene.contacts)
         traj = Trajectory(t, q, v, np.tile(g, (n, 1)), np.zeros((n, nc)), np.zeros((n, nc)),
                           np.empty((n, nc), dtype=object))
-        return SimulationResult(self.name, "ok", "reached t_end", traj, [], steps=n)
+        message = "reached t_end" if held is None else stop_message(t[-1])
+        return SimulationResult(self.name, status, message, traj, [], steps=n)
 
 
 def _heavy(scene, options, duration):

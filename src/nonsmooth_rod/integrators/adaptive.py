@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import moreau_jean_loop as loop
+from .sampling import save_slots, stop_event, stop_holds, stop_message
 from .moreau_jean_records import HISTORY, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, ResumeState
 from ..results import Event, Impact, SimulationResult, Trajectory, merge_short_phases, phases_from_intervals
 from ..solvers.two_coefficient import STATE_NAMES
@@ -320,9 +321,8 @@ def _steps(stepper: Stepper, ctrl: Controller, stops, stop_contact: int):
             hit = [imp[1] for imp in new.impacts if imp[0] == stop_contact]
             if hit:
                 return "ok", f"stopped at the impact of {stepper.integrator.options.stop_at_impact}", None
-            if stops and any(bool(c(float(new.t), new.q.copy(), new.v.copy())) for c in stops):
-                return ("stopped", f"a stop condition held at t = {new.t:.9g} s",
-                        Event(float(new.t), "stop", "", {}))
+            if stops and stop_holds(stops, new.t, new.q, new.v):
+                return "stopped", stop_message(new.t), stop_event(new.t)
     return "ok", f"reached t_end = {ctrl.t_end:g} s", None
 
 
@@ -353,7 +353,7 @@ def _samples(points: list, nc: int, save_every: float | None):
         codes[0] = codes[1]  # the first sample: the mode of the first step, as fixed steps report it
     keep = np.ones(t.shape, dtype=bool)
     if save_every is not None:
-        slot = np.floor(t / save_every + 1e-9)
+        slot = save_slots(t - t[0], save_every)
         keep[1:] = slot[1:] != slot[:-1]
         keep[-1] = True
     return t[keep], q[keep], v[keep], a[keep], N[keep], T[keep], codes[keep]

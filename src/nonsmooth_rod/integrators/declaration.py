@@ -3,8 +3,8 @@
 Each integrator class carries a `Declaration` (its `declares` attribute, next to its code): its
 options dataclass, the contact relations it runs, what else it refuses (joints, driven motions,
 a setting that does not go with the scene…), each with its one-line refusal, how many samples a
-run keeps (the one memory check) and whether its `run` keeps the scene's clock, thins and stops
-itself. The driver (driver.py) reads only this: it never asks which method it is running.
+run keeps (the one memory check) and how it checks an end state to resume from. Every `run`
+keeps the scene's clock, thins and stops itself (integrators/sampling.py). The driver (driver.py) reads only this: it never asks which method it is running.
 """
 from __future__ import annotations
 
@@ -35,8 +35,6 @@ class Declaration:
     refusals: the rest it does not run (`Refusal`s, tried in order);
     samples_estimate(options, duration, save_every): the samples a run keeps, counting what it
     holds while it runs (the driver's memory check); samples_knob: what keeps fewer;
-    absolute_time: its `run` takes `t0`, `resume`, `save_every` and `stop` and keeps the scene's
-    clock (otherwise the driver runs it from 0 on a shifted scene and thins and stops after);
     resumes: how it checks an `end_state` to continue from (None: it restarts from (q, v) alone);
     compiles(options): True when a run with these options would run numba-compiled code (the
     driver then says once if numba is missing; None: never).
@@ -47,20 +45,22 @@ class Declaration:
     samples_estimate: Callable
     samples_knob: str
     refusals: tuple = ()
-    absolute_time: bool = False
     resumes: Callable | None = None
     compiles: Callable | None = None
 
 
-def first_joint(scene, options=None, duration=None) -> dict | None:
-    """The refusal fields naming the scene's first joint, or None without joints."""
-    return {"item": f"joint {scene.joints[0].name!r}"} if scene.joints else None
+def first_item(items: Callable, field: str = "item") -> Callable:
+    """A refusal's finder: the fields {field: the first of `items(scene)`} (names, as the message
+    says them), or None when there is none."""
+    def finds(scene, options=None, duration=None) -> dict | None:
+        found = next(iter(items(scene)), None)
+        return None if found is None else {field: found}
+    return finds
 
 
-def first_driven(scene, options=None, duration=None) -> dict | None:
-    """The refusal fields naming the scene's first driven obstacle or body, or None."""
-    driven = scene.driven_things()
-    return {"item": driven[0]} if driven else None
+# The scene's first joint; its first driven obstacle or body.
+first_joint = first_item(lambda scene: (f"joint {joint.name!r}" for joint in scene.joints))
+first_driven = first_item(lambda scene: scene.driven_things())
 
 
 NO_JOINTS = Refusal(first_joint, "method {method!r} does not handle joints ({item}); use moreau-jean")
@@ -85,4 +85,4 @@ STEP_CAP = Refusal(_capped_steps, f"max_step = {{cap:g}} s over a run of {{durat
 
 
 __all__ = ["Declaration", "Refusal", "NO_JOINTS", "NO_DRIVEN", "STEP_CAP", "MAX_CAPPED_STEPS",
-           "first_joint", "first_driven"]
+           "first_item", "first_joint", "first_driven"]

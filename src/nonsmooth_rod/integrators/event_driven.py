@@ -62,7 +62,8 @@ from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from ..solvers.registry import SolverName
-from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration, Refusal
+from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration, Refusal, first_item
+from .sampling import Thinning, grid_blocks, stop_event, stop_message, thinned_count
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
@@ -112,10 +113,13 @@ def _finite_part(result: SimulationResult) -> SimulationResult:
 
 
 class _Stop(Exception):
-    def __init__(self, status, message, detail=None):
+    """The run ends here with `status`; `event`: its event (default: one of kind `status`)."""
+
+    def __init__(self, status, message, detail=None, event=None):
         self.status = status
         self.message = message
         self.detail = detail or {}
+        self.event = event
 
 
 # ---------------------------------------------------------------------- switching indicators
@@ -371,15 +375,18 @@ class _Watch:
 # ---------------------------------------------------------------------- the run's record
 @dataclass
 class _Run:
-    """The current state of a run and everything it reports."""
+    """The current state of a run and everything it reports. Its samples are kept and its stop
+    conditions tried as they come (`thinning`, integrators/sampling.py)."""
 
     t: float
     q: np.ndarray
     v: np.ndarray
+    thinning: Thinning
     events: list = field(default_factory=list)
     impacts: list = field(default_factory=list)
     samples: list = field(default_factory=list)  # blocks (t, y, modes, ModeDynamics or None)
-    boundaries: list = field(default_factory=lambda: [0.0])
+    unkept: tuple | None = None  # the last sample not kept, if later than every kept one
+    boundaries: list = field(default_factory=list)
     interval_modes: list = field(default_factory=list)
     steps: int = 0
     nfev: int = 0
@@ -388,18 +395,41 @@ class _Run:
     rest_from: float | None = None
     instant: tuple = (math.nan, {})  # (t, forced modes) of the events at the current instant
 
+    def __post_init__(self):
+        self.boundaries = [self.t]
+
     def sample(self, t, y, modes, dynamics=None):
-        self.samples.append((np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(y).copy(),
-                             list(modes), dynamics))
+        """Offer samples (times t, states y) in time order: the kept ones are stored; where a stop
+        condition holds, the run ends there (raises _Stop "stopped")."""
+        ts, ys = np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(y)
+        keep = self.thinning.keeps(ts)
+        self.unkept = None if keep[-1] else (ts[-1:], ys[-1:].copy(), list(modes), dynamics)
+        ts, ys = ts[keep], ys[keep]  # copies (a mask)
+        n = ys.shape[1] // 2
+        stop = self.thinning.first_stop(ts, ys[:, :n].copy(), ys[:, n:].copy())
+        if stop is not None:
+            ts, ys, self.unkept = ts[: stop + 1], ys[: stop + 1], None
+        if ts.size:
+            self.samples.append((ts, ys, list(modes), dynamics))
+        if stop is not None:
+            self._end_segment(float(ts[-1]), ys[-1], modes)
+            raise _Stop("stopped", stop_message(self.t), event=stop_event(self.t))
 
     def close(self, t, y, modes, dynamics=None):
         """End the current segment at t in state y (sampled there)."""
         self.sample(t, y, modes, dynamics)
+        self._end_segment(t, y, modes)
+
+    def _end_segment(self, t, y, modes):
         if t > self.boundaries[-1]:
             self.boundaries.append(t)
             self.interval_modes.append(list(modes))
         n = len(y) // 2
         self.t, self.q, self.v = t, np.array(y[:n], dtype=float), np.array(y[n:], dtype=float)
+
+    def kept_samples(self) -> list:
+        """The kept samples, and the run's last sample if it was not kept."""
+        return self.samples + ([self.unkept] if self.unkept is not None else [])
 
 
 def _force_scale(scene, t, q, v) -> float:
@@ -415,8 +445,8 @@ class EventDriven:
 
     @staticmethod
     def samples_estimate(options, duration: float, save_every: float | None) -> float:
-        """How many samples a run keeps (every output_dt; the driver thins to save_every after)."""
-        return duration / options.output_dt + 2
+        """How many samples a run keeps (every output_dt, or one per save_every, thinned as it runs)."""
+        return thinned_count(duration / options.output_dt, duration, save_every) + 2
 
     def __init__(self, options: EventDrivenOptions | None = None):
         self.options = options or EventDrivenOptions()
@@ -495,23 +525,27 @@ class EventDriven:
                     f"no consistent contact mode at t = {t:.12g} s (modes tried from {candidates}): "
                     "the sliding problem has no solution here (Painlevé-type inconsistency)")
     # ------------------------------------------------------------------ main loop
-    def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        """From (q0, v0) at 0 to t_end (inputs as the driver checked them: `declares`)."""
+    def run(self, scene: Scene, q0, v0, t_end: float, *, t0: float = 0.0, resume=None, save_every: float | None = None,
+            stop=()) -> SimulationResult:
+        """From (q0, v0) at t0 to t_end on the scene's clock (inputs as the driver checked them:
+        `declares`), keeping one sample per `save_every` (default: every output sample and event)
+        and ending at the first kept sample where a `stop` callable (t, q, v) holds. `resume` is
+        not used: the modes are decided afresh from (q0, v0)."""
         q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
         wall = time.process_time()
         names = [c.name for c in scene.contacts]
-        run = _Run(0.0, q, v)
+        run = _Run(float(t0), q, v, Thinning(t0, save_every, stop))
         # A diverging run (huge tolerances, a Painlevé blow-up) overflows inside scipy and the
         # model: no warnings on stderr, the non-finite samples end the result instead (below).
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             try:
-                modes = self._decide(scene, 0.0, q, v)
-                run.events.append(Event(0.0, "start", "", {"modes": list(modes)}))
+                modes = self._decide(scene, run.t, q, v)
+                run.events.append(Event(run.t, "start", "", {"modes": list(modes)}))
                 status, message = self._loop(scene, run, modes, t_end, names)
             except _Stop as stop:
                 status, message = stop.status, stop.message
-                run.events.append(Event(run.t, status, "", {"message": message, **stop.detail}))
+                run.events.append(stop.event or Event(run.t, status, "", {"message": message, **stop.detail}))
             result = self._result(scene, run, names, status, message, time.process_time() - wall)
         return _finite_part(result)
 
@@ -569,11 +603,8 @@ class EventDriven:
         return None if hit is None else (indicators[hit[1]].kind, indicators[hit[1]].contact)
 
     def _sample(self, run, dense, a, b, modes):
-        """Output samples on the grid k·output_dt within [a, b)."""
-        dt = self.options.output_dt
-        ts = np.arange(math.ceil(a / dt) - 1, math.ceil(b / dt) + 1) * dt
-        ts = ts[(ts >= a) & (ts < b)]
-        if ts.size:
+        """Output samples on the grid t0 + k·output_dt within [a, b)."""
+        for ts in grid_blocks(run.boundaries[0], self.options.output_dt, a, b):
             run.sample(ts, dense(ts).T, modes)
 
     def _stalled(self, scene, run, modes, solver, y0, message):
@@ -678,12 +709,9 @@ class EventDriven:
         if not np.all(np.abs(dyn.a) <= 1e-12 * a_scale):
             return False
         y = np.concatenate([run.q, v])
-        dt = self.options.output_dt
-        ts = np.arange(math.ceil(run.t / dt), math.ceil(t_end / dt) + 1) * dt
-        ts = ts[(ts >= run.t) & (ts < t_end)]
-        if ts.size:
-            run.sample(ts, np.tile(y, (ts.size, 1)), modes, dyn)
         run.rest_from = run.t
+        for ts in grid_blocks(run.boundaries[0], self.options.output_dt, run.t, t_end):
+            run.sample(ts, np.broadcast_to(y, (ts.size, y.size)), modes, dyn)
         run.close(float(t_end), y, modes, dyn)
         return True
 
@@ -744,7 +772,7 @@ class EventDriven:
 
     # ------------------------------------------------------------------ results
     def _result(self, scene, run, names, status, message, cpu_time_s) -> SimulationResult:
-        traj = self._trajectory(scene, run.samples)
+        traj = self._trajectory(scene, run.kept_samples())
         phases = {}
         if len(run.boundaries) > 1:
             for ci, name in enumerate(names):
@@ -780,11 +808,8 @@ class EventDriven:
 
 
 def _first_contact(kind):
-    """A refusal's finder: the fields naming the scene's first contact `kind(contact)` holds for."""
-    def finds(scene, options=None, duration=None):
-        found = next((c for c in scene.contacts if kind(c)), None)
-        return None if found is None else {"name": found.name}
-    return finds
+    """A refusal's finder: the name of the scene's first contact `kind(contact)` holds for."""
+    return first_item(lambda scene: (c.name for c in scene.contacts if kind(c)), "name")
 
 
 # What the reference cannot run among the relations it takes, each said in one line.

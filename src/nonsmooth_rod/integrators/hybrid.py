@@ -33,6 +33,7 @@ from ..model.dynamics import ModeDynamics, ModeSystem, mode_dynamics
 from ..solvers import available_solvers
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
+from .sampling import thinned_count
 from .event_driven import (_EPS, _TINY, EventDriven, _first_of, _force_scale, _indicator_values, _indicators,
                            _Watch)
 
@@ -217,8 +218,8 @@ class Hybrid(EventDriven):
 
     @staticmethod
     def samples_estimate(options, duration: float, save_every: float | None) -> float:
-        """One sample a step (the driver thins to save_every after), and one per event."""
-        return duration / options.h + 2 + options.max_events
+        """One sample a step and one per event, or one per save_every (thinned as it runs)."""
+        return thinned_count(duration / options.h + options.max_events, duration, save_every) + 2
 
     def __init__(self, options: HybridOptions | None = None):
         self.options = options or HybridOptions()
@@ -249,6 +250,8 @@ class Hybrid(EventDriven):
         start = _Stage(mode, run.t, np.concatenate([run.q, run.v]))
         watch = _StepWatch(mode, start)
         s_start, h = watch.values(start), self.options.h
+        if not run.samples and run.unkept is None:  # the run's first state (later segments start at a sample)
+            run.sample(start.t, start.y, modes, start.dyn)
         cap = _first_step_cap(run.boundaries)
         try:
             while True:

@@ -38,6 +38,7 @@ from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
 from .joint_step import work_size
+from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .scene_plans import scene_plan
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
@@ -271,7 +272,6 @@ class MoreauJean:
     """The Moreau–Jean one-step integrator over a Scene (one loop: moreau_jean_loop)."""
 
     name = "moreau-jean"
-    absolute_time = True  # reads the scene's clock itself (t0 + k h): the driver does not shift it
 
     def __init__(self, options: MoreauJeanOptions | None = None):
         self.options = options or MoreauJeanOptions()
@@ -287,8 +287,7 @@ class MoreauJean:
             from .adaptive import samples_estimate
             return samples_estimate(options, duration)
         steps = duration / options.h
-        kept = steps if save_every is None else min(steps, duration / save_every)
-        return kept + 2 + WINDOW_SAMPLES * min(steps, MAX_CHUNK)
+        return thinned_count(steps, duration, save_every) + 2 + WINDOW_SAMPLES * min(steps, MAX_CHUNK)
 
     def run(self, scene: Scene, q0, v0, t_end: float, *, t0: float = 0.0, resume: ResumeState | None = None,
             save_every: float | None = None, stop=()) -> SimulationResult:
@@ -361,7 +360,7 @@ class MoreauJean:
     def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops):
         """Run the grid's steps window by window; returns (run status, global step the run ended at)."""
         k, counters = grid.first, window.out[9]
-        if stops and self._stop_holds(stops, grid.time(k), window.out[0][window.r], window.out[1][window.r]):
+        if stops and stop_holds(stops, grid.time(k), window.out[0][window.r], window.out[1][window.r]):
             collector.take(window, k, k, final=True)
             return loop.RUN_STOPPED_BY_CONDITION, k
         while k < grid.last:
@@ -414,17 +413,13 @@ class MoreauJean:
         window.r = int(counters[loop.K_DONE])
         return int(status), window.k_base + window.r
 
-    @staticmethod
-    def _stop_holds(stops, t, q, v) -> bool:
-        return any(bool(cond(float(t), q.copy(), v.copy())) for cond in stops)
-
     def _first_hold(self, stops, collector, window, k_from, k_to):
         """The first kept step in (k_from, k_to] where a stop condition holds, or None."""
-        for k in kept_steps(collector.grid, k_from + 1, k_to, collector.save_every):
-            r = k - window.k_base
-            if k > k_from and self._stop_holds(stops, collector.grid.time(k), window.out[0][r], window.out[1][r]):
-                return int(k)
-        return None
+        ks = kept_steps(collector.grid, k_from + 1, k_to, collector.save_every)
+        ks = ks[ks > k_from]
+        rows = ks - window.k_base  # q, v rows copied (fancy indexing): the conditions' own
+        held = first_hold(stops, collector.grid.time(ks), window.out[0][rows], window.out[1][rows])
+        return None if held is None else int(ks[held])
 
     def _run_stepwise(self, kernels, scene, r_start, r_end, params, iparams, model, work, out):
         """The loop step by step from Python: for a Python `applied_force` (called back for each
@@ -490,7 +485,7 @@ class MoreauJean:
         q, states, counters = out[0], out[5], out[9]
         t_end = float(grid.time(k_end))
         if status == loop.RUN_STOPPED_BY_CONDITION:
-            return Status.STOPPED, f"a stop condition held at t = {t_end:.9g} s", Event(t_end, "stop", "", {})
+            return Status.STOPPED, stop_message(t_end), stop_event(t_end)
         k = window.k_base + int(counters[loop.K_FAIL_STEP])  # the failing step
         t_k = float(grid.origin + k * grid.h)
         if status == loop.RUN_NONFINITE:
@@ -578,7 +573,7 @@ MoreauJean.declares = Declaration(
     samples_estimate=MoreauJean.samples_estimate, samples_knob=MoreauJean.SAMPLES_KNOB,
     refusals=(Refusal(_tol_with_joints_or_driven, "tol: error control does not handle joints or driven obstacles "
                                                   "and bodies yet ({item}); give a fixed step h instead"),),
-    absolute_time=True, resumes=check_resume, compiles=lambda options: options.fast)
+    resumes=check_resume, compiles=lambda options: options.fast)
 
 def joint_forces(joints, impulses_over_h) -> dict:
     """{joint name: {reaction: samples}}: a pin's world force (Fx, Fy) on body_a, a slider's force

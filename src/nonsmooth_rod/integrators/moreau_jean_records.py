@@ -25,6 +25,7 @@ from functools import cached_property
 import numpy as np
 
 from . import moreau_jean_loop as loop
+from .sampling import save_slots
 
 # Rows of records a window keeps from the steps before its first: the warm start reads one, the
 # location of a phase boundary at step k reads steps k − 4 … k − 1 (moreau_jean._boundary_offset).
@@ -177,8 +178,8 @@ def kept_steps(grid: Grid, lo: int, hi: int, save_every: float | None) -> np.nda
     k = np.arange(lo, hi + 1)
     if save_every is None:
         return k
-    slot = np.floor(k * grid.h / save_every + 1e-9)
-    keep = slot != np.floor((k - 1) * grid.h / save_every + 1e-9)
+    slot = save_slots(k * grid.h, save_every)
+    keep = slot != save_slots((k - 1) * grid.h, save_every)
     keep |= (k == grid.first) | (k == grid.last)
     return k[keep]
 

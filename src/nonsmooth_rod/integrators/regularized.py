@@ -53,6 +53,7 @@ from ..results import Event, Impact, SimulationResult, Trajectory, merge_short_p
 from ..validation import Choice, InputError, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration
 from .event_driven import ATOL_CEILING, RTOL_FLOOR
+from .sampling import Thinning, stop_event, stop_message, thinned_count
 
 FRICTION_CURVES = ("stribeck", "tanh", "linear")
 ODE_METHODS = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA, "RK23": RK23}
@@ -178,8 +179,9 @@ class _Record:
     t_stop: float | None = None
     steps: int = 0
     max_penetration: float = 0.0
-    next_sample: int = 1
-    grid: np.ndarray = None
+    thinning: Thinning = None
+    t0: float = 0.0
+    next_sample: int = 1  # the next sample of the output grid t0 + k·output_dt
     samples_t: list = field(default_factory=list)
     samples_y: list = field(default_factory=list)
     step_sizes: list = field(default_factory=list)
@@ -211,8 +213,8 @@ class Regularized:
 
     @staticmethod
     def samples_estimate(options, duration: float, save_every: float | None) -> float:
-        """How many samples a run keeps (every output_dt; the driver thins to save_every after)."""
-        return duration / options.output_dt + 2
+        """How many samples a run keeps (every output_dt, or one per save_every, thinned as it runs)."""
+        return thinned_count(duration / options.output_dt, duration, save_every) + 2
 
     def __init__(self, options: RegularizedOptions | None = None):
         self.options = options or RegularizedOptions()
@@ -268,16 +270,19 @@ class Regularized:
         return "slip+" if u_T > 0 else "slip-"
 
     # ------------------------------------------------------------------ main loop
-    def run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        """Integrate from (q0, v0) to t_end (or the stop contact's touchdown)."""
+    def run(self, scene: Scene, q0, v0, t_end: float, *, t0: float = 0.0, resume=None, save_every: float | None = None,
+            stop=()) -> SimulationResult:
+        """Integrate from (q0, v0) at t0 to t_end on the scene's clock (or the stop contact's
+        touchdown), keeping one sample per `save_every` (default: every output_dt) and ending at
+        the first kept sample where a `stop` callable (t, q, v) holds. `resume` is not used."""
         # Implicit methods try states far off the solution (rejected steps, Jacobian columns):
         # their overflows are not results. A non-finite accepted state ends the run as "nan".
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            return self._run(scene, q0, v0, t_end)
+            return self._run(scene, q0, v0, t_end, Thinning(t0, save_every, stop))
 
-    def _run(self, scene: Scene, q0, v0, t_end: float) -> SimulationResult:
-        solver, rec = self._start(scene, q0, v0, t_end)
+    def _run(self, scene: Scene, q0, v0, t_end: float, thinning: Thinning) -> SimulationResult:
+        solver, rec = self._start(scene, q0, v0, t_end, thinning)
         try:
             while solver.status == "running" and rec.status == "ok" and rec.t_stop is None:
                 self._step(solver, rec)
@@ -286,8 +291,8 @@ class Regularized:
             rec.message = f"wall-clock limit of {self.options.time_limit:g} s reached at t = {solver.t:.9g} s"
         return self._finish(solver, rec)
 
-    def _start(self, scene: Scene, q0, v0, t_end: float):
-        """The ODE solver at t = 0 and the record of the run (samples, states, events)."""
+    def _start(self, scene: Scene, q0, v0, t_end: float, thinning: Thinning):
+        """The ODE solver at t0 and the record of the run (samples, states, events)."""
         o = self.options
         self._scene = scene
         self._n_dof = n = scene.n_dof
@@ -298,21 +303,22 @@ class Regularized:
         names = [c.name for c in scene.contacts]
         rec = _Record(names=names, wall0=time.perf_counter(), cpu0=time.process_time(),
                       stop_index=names.index(o.stop_at_impact) if o.stop_at_impact in names else None,
-                      message=f"reached t_end = {t_end:g} s")
+                      message=f"reached t_end = {t_end:g} s", thinning=thinning, t0=thinning.t0)
         self._deadline = None if o.time_limit is None else rec.wall0 + o.time_limit
         y = np.concatenate([np.asarray(q0, float), np.asarray(v0, float)])
         kwargs = dict(rtol=o.rtol, atol=o.atol, max_step=o.max_step)
         if o.first_step is not None:
             kwargs["first_step"] = o.first_step
-        solver = ODE_METHODS[o.ode_method](self._rhs, 0.0, y, t_end, **kwargs)
-        grid = np.arange(0.0, t_end + 0.5 * o.output_dt, o.output_dt)
-        rec.grid = grid[grid <= t_end]
-        rec.samples_t, rec.samples_y = [0.0], [y.copy()]
+        solver = ODE_METHODS[o.ode_method](self._rhs, rec.t0, y, t_end, **kwargs)
+        rec.samples_t, rec.samples_y = [rec.t0], [y.copy()]
+        thinning.keeps(rec.t0)
+        if thinning.first_stop([rec.t0], [y[:n].copy()], [y[n:].copy()]) is not None:
+            rec.t_stop, rec.status, rec.message = rec.t0, "stopped", stop_message(rec.t0)
         rec.local = [c.local(y, n) for c in self._contacts]
         states = [self._state_of(g, u) for g, _, u, _, _ in rec.local]
         # A contact starting exactly at gap 0 with no approach velocity is resting, not open.
         rec.states = [("stick" if s == "open" and abs(loc[0]) < 1e-12 else s) for s, loc in zip(states, rec.local)]
-        rec.changes = [[(0.0, s)] for s in rec.states]
+        rec.changes = [[(rec.t0, s)] for s in rec.states]
         return solver, rec
 
     def _step(self, solver, rec) -> None:
@@ -333,6 +339,14 @@ class Regularized:
         if rec.stop_index is not None and rec.local[rec.stop_index][0] > 0.0 >= new_local[rec.stop_index][0]:
             self._touchdown(rec, dense, t_old, solver.t)
         t_limit = rec.t_stop if rec.t_stop is not None else solver.t
+        t_held = self._take_samples(rec, dense, t_limit)
+        if t_held is not None:  # a stop condition holds there: the run ends at that sample
+            if rec.t_stop is not None and t_held < rec.t_stop:  # before the stop contact's touchdown
+                rec.impacts.pop()
+                rec.events.pop()
+            rec.t_stop, t_limit = t_held, t_held
+            rec.status, rec.message = "stopped", stop_message(t_held)
+            new_local = [c.local(dense()(t_held), n) for c in self._contacts]
         for ci, c in enumerate(self._contacts):
             new_state = self._state_of(new_local[ci][0], new_local[ci][2])
             if new_state != rec.states[ci]:
@@ -340,11 +354,9 @@ class Regularized:
                                         new_state))
                 rec.states[ci] = new_state
             rec.max_penetration = max(rec.max_penetration, -new_local[ci][0])
-        while rec.next_sample < rec.grid.size and rec.grid[rec.next_sample] <= t_limit:
-            rec.samples_t.append(float(rec.grid[rec.next_sample]))
-            rec.samples_y.append(dense()(rec.grid[rec.next_sample]))
-            rec.next_sample += 1
         rec.local = new_local
+        if rec.status == "stopped":
+            return
         if rec.t_stop is not None:
             rec.samples_t.append(rec.t_stop)
             rec.samples_y.append(dense()(rec.t_stop))
@@ -353,6 +365,21 @@ class Regularized:
             rec.status = "penetration"
             rec.message = (f"penetration {rec.max_penetration:.3g} m exceeds {o.max_penetration:g} m at "
                            f"t = {solver.t:.9g} s")
+
+    def _take_samples(self, rec, dense, t_limit: float) -> float | None:
+        """The output grid's samples up to t_limit, the kept ones stored; the time of the first
+        kept one where a stop condition holds (the samples end there), or None."""
+        n, dt = self._n_dof, self.options.output_dt
+        while (t := rec.t0 + rec.next_sample * dt) <= t_limit:
+            rec.next_sample += 1
+            if not rec.thinning.keeps(t)[0]:
+                continue
+            y = dense()(t)
+            rec.samples_t.append(float(t))
+            rec.samples_y.append(y)
+            if rec.thinning.first_stop([t], [y[:n].copy()], [y[n:].copy()]) is not None:
+                return float(t)
+        return None
 
     def _touchdown(self, rec, dense, t_old: float, t_new: float) -> None:
         """The stop contact's gap closed within the step: its root on the dense output."""
@@ -374,7 +401,9 @@ class Regularized:
             rec.samples_y.append(solver.y.copy())
         traj = self._trajectory(rec.samples_t, rec.samples_y)
         phases = {name: self._phases(rec.changes[ci], t_final) for ci, name in enumerate(rec.names)}
-        if rec.status != "ok":
+        if rec.status == "stopped":
+            rec.events.append(stop_event(t_final))
+        elif rec.status != "ok":
             rec.events.append(Event(t_final, rec.status, "", {"message": rec.message}))
         h_arr = np.array(rec.step_sizes) if rec.step_sizes else np.array([np.nan])
         stats = {"nfev": self._nfev, "njev": int(getattr(solver, "njev", 0)), "nlu": int(getattr(solver, "nlu", 0)),

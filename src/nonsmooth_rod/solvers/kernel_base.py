@@ -35,10 +35,12 @@ def takes_block_sparse(solver_code) -> bool:
     return 0 <= solver_code < len(BLOCK_SPARSE_CODES) and BLOCK_SPARSE_CODES[solver_code]
 
 
-@jit
+@jit_borrowing
 def all_finite(values) -> bool:
-    """True when no entry of the (flattened) array is NaN or ±inf."""
-    for x in values.ravel():
+    """True when no entry of the array (a vector, a matrix, a stack of blocks) is NaN or ±inf.
+    Borrowing (the step's hot path screens its problem with it): `flat` walks the array where it
+    lies, contiguous or not, where `ravel` would copy a non-contiguous one."""
+    for x in values.flat:
         if not np.isfinite(x):
             return False
     return True

@@ -88,17 +88,8 @@ def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
 @jit_borrowing
 def _screen(W, q, lo, hi, p, u):
     """The status of a problem no solver needs to see (non-finite data: p = 0, u = q; no
-    contacts), or −1 when a solver must run. (Borrowing, on the step's hot path: loops, not
-    all_finite's ravel.)"""
-    finite = True
-    for i in range(W.shape[0]):
-        for j in range(W.shape[1]):
-            finite = finite and np.isfinite(W[i, j])
-    for i in range(q.shape[0]):
-        finite = finite and np.isfinite(q[i])
-    for i in range(lo.shape[0]):
-        finite = finite and np.isfinite(lo[i]) and np.isfinite(hi[i])
-    if not finite:
+    contacts), or −1 when a solver must run. (Borrowing, on the step's hot path.)"""
+    if not (all_finite(W) and all_finite(q) and all_finite(lo) and all_finite(hi)):
         for i in range(q.shape[0]):
             p[i], u[i] = 0.0, q[i]
         return KERNEL_NONFINITE
