@@ -225,9 +225,9 @@ class Hybrid(EventDriven):
         self.options = options or HybridOptions()
         self._systems = {}
 
-    def run(self, scene, q0, v0, t_end):
+    def run(self, scene, q0, v0, t_end, **clock):
         self._systems = {}  # the compiled mode solves set up in this run, by modes and what they watch
-        return super().run(scene, q0, v0, t_end)
+        return super().run(scene, q0, v0, t_end, **clock)  # clock: t0, resume, save_every, stop
 
     def _system(self, scene, modes, watched=()) -> ModeSystem:
         key = (tuple(modes), watched)
@@ -251,7 +251,7 @@ class Hybrid(EventDriven):
         watch = _StepWatch(mode, start)
         s_start, h = watch.values(start), self.options.h
         if not run.samples and run.unkept is None:  # the run's first state (later segments start at a sample)
-            run.sample(start.t, start.y, modes, start.dyn)
+            run.sample(start.t, start.y, modes, start.dynamics())
         cap = _first_step_cap(run.boundaries)
         try:
             while True:
