@@ -202,23 +202,31 @@ def _guess_of_states(states, guess):
         guess[i] = 1.0 if states[i] == STATE_SLIP_PLUS else (-1.0 if states[i] == STATE_SLIP_MINUS else 0.0)
 
 
-@jit
+@jit_borrowing
 def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
                  states, p_start):
     """Hold what μs can hold (sticking.prefer_sticking, group by group of coupled contacts) when a
     contact that started the step at rest — slip velocity round-off at the step's start
     (`resting` 1), slip guess 0 — does not stick; True when p, u, states were replaced. The
-    common step returns at once. A contact that was already sliding (or grazing a rolling
-    neighbour) keeps the solver's answer: the search costs milliseconds on rows of balls and has
-    nothing to hold there. Groups of more than MAX_DENSE_HOLD contacts keep the solver's split.
-    p_start: the previous step's impulses (the warm start), or empty."""
-    na = mu_s.shape[0]
+    common step returns at once (borrowing: it counts and allocates nothing). A contact that was
+    already sliding (or grazing a rolling neighbour) keeps the solver's answer: the search costs
+    milliseconds on rows of balls and has nothing to hold there. Groups of more than MAX_DENSE_HOLD
+    contacts keep the solver's split. p_start: the previous step's impulses (the warm start), or empty."""
     moving = False
-    for i in range(na):
+    for i in range(mu_s.shape[0]):
         if resting[i] > 0.0 and start_guess[i] == 0.0 and states[i] != STATE_STICK:
             moving = True
-    if not moving:  # the common step: nothing to search, nothing allocated
+    if not moving:  # the common step: nothing to search
         return False
+    return _hold_search(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
+                        states, p_start)
+
+
+@jit
+def _hold_search(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
+                 states, p_start):
+    """hold_at_rest's search (counted: it allocates)."""
+    na = mu_s.shape[0]
     at_rest = np.empty(na)
     for i in range(na):
         at_rest[i] = start_guess[i] if resting[i] > 0.0 else 2.0  # 2: not a candidate
