@@ -215,7 +215,7 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
                 j += 1
 
 
-@jit
+@jit_borrowing
 def pass_through_depth(table, index, i):
     """How deep contact i may go before its body has passed through the obstacle: the disk's radius
     (of two disks the smaller; a disk on a body's corner, the disk's); 0 — no such check — for a
@@ -478,7 +478,7 @@ def crossing_offset(g, u, a, h):
     return 0.0 if math.isnan(best) else best
 
 
-@jit
+@jit_borrowing
 def _record_impact(k, t, i, u_before, gap, acceleration, params, iparams, impact_t, impact_step, impact_contact,
                    counters):
     """Book contact i's impact in step k (its gap at the step's start, u_N before, normal
@@ -628,7 +628,7 @@ def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buff
     project_positions(q_next, minv, table, J, C, held, held_bodies, n_held)
 
 
-@jit
+@jit_borrowing
 def _rides_the_gap(i, params, gaps, drifts, hn, ht, a_free, table, index, v_next):
     """A persistent contact that got no impulse but ends the step within h² |g̈| of
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
@@ -916,7 +916,7 @@ def _after_step(k, k_start, k_end, work, out, memory, before):
     return k
 
 
-@jit
+@jit_borrowing
 def _fixed_period(k, steps_here, q, v, p_normal, p_tangent, memory):
     """1 or 2 when the state step k leaves — q, v, the contacts' memory and the impulses the next
     step warm-starts from — is the one left by step k − 1 (a rest) or k − 2 (a two-step cycle of
