@@ -6,6 +6,7 @@ import pytest
 from nonsmooth_rod import _jit
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.integrators.moreau_jean_loop import SCRATCH_W_CONTACTS
+from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.toys import stacks
 
 G = 9.81
@@ -28,19 +29,27 @@ def test_a_row_at_rest_beyond_the_dense_scratch_holds_with_lemke():
     assert np.max(np.abs(run.trajectory.tangential_force[1:])) <= 1e-12 * weight
 
 
-@pytest.mark.skipif(not _jit.ENABLED, reason="numba's allocation counters: the compiled loop")
-@pytest.mark.parametrize("steps", [100])
-def test_a_pgs_step_allocates_nothing(steps):
-    """A pile of 4 rows resting between its walls (75 contacts, ~20 active, pgs, every step
-    solved): a run of 2n steps allocates exactly what a run of n steps does — the per-run scratch
-    and records, nothing per step."""
-    from numba.core.runtime import rtsys
+def _rod():
+    rod = RodProblem.paper(2)
+    return (rod.scene(), *rod.initial_state()), 1e-4, 1500  # through ball A's impact
 
-    scene, q0, v0 = stacks.disk_pile(4)
-    h = 1e-3
+
+def _resting_row():
+    return stacks.ball_row(8, speed=0.0), 1e-3, 100  # 8 loaded floor contacts, 7 pairs apart
+
+
+@pytest.mark.skipif(not _jit.ENABLED, reason="numba's allocation counters: the compiled loop")
+@pytest.mark.parametrize("case", [_rod, _resting_row])
+def test_a_pgs_step_allocates_nothing(case):
+    """A run of 2n pgs steps allocates exactly what a run of n steps does — the per-run scratch
+    and records, nothing per step — where neither the hold search nor pgs's mode polish runs (they
+    allocate, docs/solvers.md): the paper's rod, a row of balls at rest."""
+    from numba.core.runtime import _nrt_python as nrt_stats, rtsys
+
+    (scene, q0, v0), h, steps = case()
     solver = MoreauJean(MoreauJeanOptions(h=h, solver="pgs", repeat_rest=False))
     assert solver.run(scene, q0, v0, h * steps).stats["compiled"]  # compiled, warm
-    rtsys.memsys_enable_stats()
+    nrt_stats.memsys_enable_stats()
     try:
         counts = []
         for n in (steps, 2 * steps):
@@ -49,5 +58,5 @@ def test_a_pgs_step_allocates_nothing(steps):
             assert run.status == "ok" and run.steps == n
             counts.append(rtsys.get_allocation_stats().alloc - before)
     finally:
-        rtsys.memsys_disable_stats()
+        nrt_stats.memsys_disable_stats()
     assert counts[0] == counts[1], counts
