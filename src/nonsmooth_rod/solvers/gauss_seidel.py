@@ -53,7 +53,7 @@ from .kernel_base import (
     problem_scale,
 )
 from .problem import NoConvergence, PlanarFrictionProblem
-from .delassus import count_blocks, coupled_components, dense_to_blocks, fill_blocks, group_matrix
+from .delassus import count_blocks, coupled_components, fill_blocks, group_matrix
 from .sticking import gather_contacts
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or

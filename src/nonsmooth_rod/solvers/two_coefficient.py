@@ -28,7 +28,7 @@ from .._jit import jit, jit_borrowing
 # The solver call point: the compiled kernels (registry.SOLVERS with a code); the QP solvers stay
 # Python (solve_two_coefficient below).
 from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fits_scratch, fitting_scratch,
-                      lemke_interval, pgs_block_into, solve_interval_into, solver_floats, solver_ints, solver_scratch)
+                      lemke_interval, pgs_block_into, solve_interval_into, solver_floats, solver_ints)
 from .gauss_seidel import PGS_FLOATS
 from ._common import interpreted
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
