@@ -341,8 +341,8 @@ def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
     indptr, indices, 2×2 blocks): a block for each pair of contacts sharing a body, so building
     it costs O(active contacts × contacts per body), not O(contacts²). Written into the scratch
     (ints, floats: S_SPARSE_INTS, S_SPARSE_FLOATS, sized by step_scratch for any active set):
-    indptr = ints[:na + 1], indices = ints[SPARSE_INDICES(na, bodies):][:nnz], blocks =
-    floats[:4 nnz]; returns nnz (sparse_views carves them). Borrowing: it allocates nothing."""
+    indptr first, then its work arrays, then the nnz columns; the blocks at the front of floats.
+    Returns nnz (sparse_views carves the three). Borrowing: it allocates nothing."""
     n_bodies = minv.shape[0] // 3
     indptr, at = carve(ints, 0, na + 1)
     start, at = carve(ints, at, n_bodies + 1)
