@@ -37,11 +37,11 @@ from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
                              contact_kinematics, drive_contacts, row_dot)
-from ..solvers.kernels import carve, carve_matrix, fitting_scratch, solver_scratch, takes_block_sparse
+from ..solvers.kernels import carve, carve_matrix, solver_scratch, takes_block_sparse
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
                          project_positions)
 from ..solvers.two_coefficient import (KERNEL_SOLVED, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS,
-                                       two_coefficient_by_group, two_coefficient_into)
+                                       pgs_scratch_sizes, two_coefficient_by_group, two_coefficient_into)
 
 # Gaps below a picometre count as touching: a contact placed exactly on a line computes a gap
 # of a few ulps either side of zero, and must not be left out of the step for that.
@@ -65,6 +65,9 @@ RUN_OK, RUN_SOLVER_FAILED, RUN_NONFINITE, RUN_STOPPED, RUN_BAD_GEOMETRY = 0, 1, 
 RUN_PASSED_THROUGH = 6
 # (set from Python, between windows: a stop condition held at a kept sample)
 RUN_STOPPED_BY_CONDITION = 5
+# (never leaves _run) a step's dense W does not fit the per-run scratch: _run grows it and goes on
+# from that step (Scratch.need: the step, its active contacts)
+RUN_SCRATCH_SHORT = 7
 # Slots of the int64 `counters` record.
 (K_DONE, K_STATUS, K_FAIL_STEP, K_N_IMPACTS, K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_SOLVER_STATUS,
  K_FAIL_CONTACT, K_FALLBACKS, K_REPEATED) = range(11)
@@ -82,11 +85,13 @@ N_PARAMS = 7
 I_SOLVER, I_MAX_ITER, I_STOP, I_TIME_INVARIANT = range(4)
 N_IPARAMS = 4
 # Slots of the per-run scratch (step_scratch): the step's temporaries, allocated once per call of
-# run_steps instead of ~40 small arrays per step. Sized by the scene's contacts;
-# the dense W (lemke, enum) for steps of up to SCRATCH_W_CONTACTS active contacts, the solver's
-# (kernel_base.solver_scratch) for groups of up to SCRATCH_SOLVER_CONTACTS: larger ones allocate
-# their own, as every step did before.
-S_FLOATS, S_STATES, S_W, S_SOLVER_FLOATS, S_SOLVER_INTS, S_SPARSE_INTS, S_SPARSE_FLOATS = range(7)
+# run_steps instead of ~40 small arrays per step. Sized by the scene's contacts: pgs's (the
+# block-sparse W, the sign iteration, the sweeps and the fallback to Lemke) for any active set;
+# the dense W (lemke, enum, joints) for SCRATCH_W_CONTACTS active contacts, grown by _run when a step
+# has more (RUN_SCRATCH_SHORT: rare, and outside the borrowing step); the dense solvers' for
+# groups of up to SCRATCH_SOLVER_CONTACTS (a larger group's split allocates its own:
+# two_coefficient._by_group_split).
+S_FLOATS, S_STATES, S_W, S_SOLVER_FLOATS, S_SOLVER_INTS, S_SPARSE_INTS, S_SPARSE_FLOATS, S_NEED = range(8)
 SCRATCH_W_CONTACTS = 64
 SCRATCH_SOLVER_CONTACTS = 16
 # Slots of the `model` tuple appended for driven obstacles and bodies (model/motion.py): the packed
@@ -111,8 +116,9 @@ Model = namedtuple("Model", "minv weight contacts contact_index force_table forc
 Work = namedtuple("Work", "gaps drifts hn ht active was_closed grazing slip_sign v_free a_free candidate joint_buffer")
 Records = namedtuple("Records", "q v p_normal p_tangent slip states impact_t impact_step impact_contact counters "
                      "joint_impulse")
-# A step's temporaries (step_scratch), allocated once per call of the loop.
-Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints sparse_ints sparse_floats")
+# A step's temporaries (step_scratch), allocated once per call of the loop; need: the step and
+# active contacts a RUN_SCRATCH_SHORT asks room for.
+Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints sparse_ints sparse_floats need")
 
 
 def new_records(n_dof, n_contacts, rows, impacts, joint_rows):
@@ -209,7 +215,7 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
                 j += 1
 
 
-@jit
+@jit_borrowing
 def pass_through_depth(table, index, i):
     """How deep contact i may go before its body has passed through the obstacle: the disk's radius
     (of two disks the smaller; a disk on a body's corner, the disk's); 0 — no such check — for a
@@ -305,12 +311,13 @@ def _block_entries(hn, ht, index, i, j, minv):
     return nn, nt, tn, tt
 
 
-@jit
+@jit_borrowing
 def _contacts_by_body(na, active, index, start, fill, members):
     """start, members: the active contacts (positions in `active`) touching each body, CSR
     (start: n_bodies + 1 entries, members: 2 na; fill: n_bodies + 1 entries of scratch)."""
     n_bodies = start.shape[0] - 1
-    start[:] = 0
+    for b in range(n_bodies + 1):
+        start[b] = 0
     for a in range(na):
         for side in range(2):
             body = index[active[a], CI_BODY_A + side]
@@ -318,7 +325,8 @@ def _contacts_by_body(na, active, index, start, fill, members):
                 start[body + 1] += 1
     for b in range(n_bodies):
         start[b + 1] += start[b]
-    fill[:] = start
+    for b in range(n_bodies + 1):
+        fill[b] = start[b]
     for a in range(na):
         for side in range(2):
             body = index[active[a], CI_BODY_A + side]
@@ -327,30 +335,25 @@ def _contacts_by_body(na, active, index, start, fill, members):
                 fill[body] += 1
 
 
-@jit
+@jit_borrowing
 def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
     """The block-sparse Delassus matrix over the active contacts (solvers/delassus.py's block layout:
     indptr, indices, 2×2 blocks): a block for each pair of contacts sharing a body, so building
-    it costs O(active contacts × contacts per body), not O(contacts²). Carved from the scratch
-    (ints, floats: S_SPARSE_INTS, S_SPARSE_FLOATS, sized by step_scratch for any active set). The
-    arrays it reads are passed one by one: a call that takes the model and work tuples costs
-    ~10 ns of reference counting per array in them, every step."""
+    it costs O(active contacts × contacts per body), not O(contacts²). Written into the scratch
+    (ints, floats: S_SPARSE_INTS, S_SPARSE_FLOATS, sized by step_scratch for any active set):
+    indptr first, then its work arrays, then the nnz columns; the blocks at the front of floats.
+    Returns nnz (sparse_views carves the three). Borrowing: it allocates nothing."""
     n_bodies = minv.shape[0] // 3
-    start, at = carve(ints, 0, n_bodies + 1)
+    indptr, at = carve(ints, 0, na + 1)
+    start, at = carve(ints, at, n_bodies + 1)
     fill, at = carve(ints, at, n_bodies + 1)
     members, at = carve(ints, at, 2 * na)
-    indptr, at = carve(ints, at, na + 1)
     seen, at = carve(ints, at, na)
     _contacts_by_body(na, active, index, start, fill, members)
     indptr[0] = 0
-    seen[:] = -1
     for sweep in range(2):  # count, then fill
-        if sweep == 1:
-            nnz = indptr[na]
-            fits = at + nnz <= ints.shape[0] and 4 * nnz <= floats.shape[0]
-            indices = ints[at:at + nnz] if fits else np.empty(nnz, dtype=np.int64)
-            blocks = floats[:4 * nnz].reshape((nnz, 2, 2)) if fits else np.empty((nnz, 2, 2))
-            seen[:] = -1
+        for a in range(na):
+            seen[a] = -1
         for a in range(na):
             n = 0
             for side in range(2):
@@ -360,14 +363,21 @@ def delassus_blocks(na, minv, index, hn, ht, active, ints, floats):
                     if seen[b] != a:
                         seen[b] = a
                         if sweep == 1:
-                            indices[indptr[a] + n] = b
                             k = indptr[a] + n
-                            blocks[k, 0, 0], blocks[k, 0, 1], blocks[k, 1, 0], blocks[k, 1, 1] = _block_entries(
+                            ints[at + k] = b
+                            floats[4 * k], floats[4 * k + 1], floats[4 * k + 2], floats[4 * k + 3] = _block_entries(
                                 hn, ht, index, active[a], active[b], minv)
                         n += 1
             if sweep == 0:
                 indptr[a + 1] = indptr[a] + n
-    return indptr, indices, blocks
+    return indptr[na]
+
+
+@_inlined
+def sparse_views(na, n_bodies, nnz, ints, floats):
+    """(indptr, indices, blocks): the views of the block-sparse W delassus_blocks wrote."""
+    at = na + 1 + 2 * (n_bodies + 1) + 3 * na
+    return ints[:na + 1], ints[at:at + nnz], floats[:4 * nnz].reshape((nnz, 2, 2))
 
 
 @jit
@@ -468,7 +478,7 @@ def crossing_offset(g, u, a, h):
     return 0.0 if math.isnan(best) else best
 
 
-@jit
+@jit_borrowing
 def _record_impact(k, t, i, u_before, gap, acceleration, params, iparams, impact_t, impact_step, impact_contact,
                    counters):
     """Book contact i's impact in step k (its gap at the step's start, u_N before, normal
@@ -618,7 +628,7 @@ def _joints_project(q_next, na, states, active, hn, ht, index, minv, table, buff
     project_positions(q_next, minv, table, J, C, held, held_bodies, n_held)
 
 
-@jit
+@jit_borrowing
 def _rides_the_gap(i, params, gaps, drifts, hn, ht, a_free, table, index, v_next):
     """A persistent contact that got no impulse but ends the step within h² |g̈| of
     its obstacle: it carries no force (reported open) but has not come apart, so its next loaded
@@ -642,36 +652,45 @@ def _warm_start(k, na, active, was_closed, p_normal, p_tangent, p):
 
 
 @jit
-def step_scratch(solver_code, model):
-    """The per-run scratch (Scratch) for the packed scene `model`."""
+def step_scratch(solver_code, model, dense_contacts):
+    """The per-run scratch (Scratch) for the packed scene `model`: pgs's for any active set, the
+    dense W for max(SCRATCH_W_CONTACTS, dense_contacts) active contacts (or the scene's)."""
     n_contacts, n_bodies = model.contacts.shape[0], model.minv.shape[0] // 3
-    sparse = takes_block_sparse(solver_code)
-    dense = 0 if sparse else min(n_contacts, SCRATCH_W_CONTACTS)
+    sparse = takes_block_sparse(solver_code) and model.joints.shape[0] == 0  # as solve_arrays
+    dense = 0 if sparse else min(n_contacts, max(SCRATCH_W_CONTACTS, dense_contacts))
     blocks = _sparse_capacity(model.contact_index, n_bodies) if sparse else 0
-    solver_floats, solver_ints = solver_scratch(min(n_contacts, SCRATCH_SOLVER_CONTACTS))
+    if sparse:
+        n_floats, n_ints = pgs_scratch_sizes(n_contacts)
+        solver_floats, solver_ints = np.empty(n_floats), np.empty(n_ints, dtype=np.int64)
+    else:
+        solver_floats, solver_ints = solver_scratch(min(n_contacts, SCRATCH_SOLVER_CONTACTS))
     sparse_ints = 2 * n_bodies + 4 * n_contacts + 3 + blocks if sparse else 0
     return Scratch(np.empty(11 * n_contacts), np.empty(n_contacts, dtype=np.int64), np.empty(4 * dense * dense),
-                   solver_floats, solver_ints, np.empty(sparse_ints, dtype=np.int64), np.empty(4 * blocks))
+                   solver_floats, solver_ints, np.empty(sparse_ints, dtype=np.int64), np.empty(4 * blocks),
+                   np.zeros(2, dtype=np.int64))
 
 
 @_inlined
 def _dense_matrix(scratch_w, m, sparse):
-    """The step's dense W (m × m, every entry written by assemble): a view of the scratch, empty
-    for pgs, or a matrix of its own beyond the scratch's size."""
-    if sparse:
-        return carve_matrix(scratch_w, 0, 0, 0)[0]
-    if m * m <= scratch_w.shape[0]:
-        return carve_matrix(scratch_w, 0, m, m)[0]
-    return np.empty((m, m))
+    """The step's dense W (m × m, every entry written by assemble): a view of the scratch (that
+    holds it: step_arrays asked _run for room first), empty for pgs."""
+    return carve_matrix(scratch_w, 0, 0 if sparse else m, 0 if sparse else m)[0]
 
 
-@jit
+@_inlined
+def _dense_fits(solver_code, na, joints, scratch_w):
+    """True when the step's W (dense for lemke, enum and joints; block-sparse for pgs) fits the scratch."""
+    sparse = takes_block_sparse(solver_code) and joints.shape[0] == 0
+    return sparse or 4 * na * na <= scratch_w.shape[0]
+
+
+@jit_borrowing
 def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht,
                  active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, s_floats, s_w,
                  s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats, p, u, states):
     """assemble + the two-coefficient kernel into p, u, states (step_impulses' views), in the
     per-run scratch (s_*: Scratch's arrays); p_normal, p_tangent: the records (the warm start).
-    Returns the kernel status. (It counts references: it may allocate, a W beyond the scratch.)"""
+    Returns the kernel status. Borrowing: it allocates nothing (the dense W fits: step_arrays)."""
     m = 2 * na
     # pgs sweeps the block-sparse W; lemke, enum need it dense, and so do joints (W_c couples a cluster)
     sparse = takes_block_sparse(solver_code) and joints.shape[0] == 0
@@ -684,16 +703,17 @@ def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index
     resting, at = carve(s_floats, at, na)
     assemble_arrays(params, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht, active, was_closed,
                     grazing, slip_sign, v_free, W, q_step, guess, mu_s, mu_d, closing, resting)
-    p[:] = 0.0
-    u[:] = 0.0
-    states[:] = 0
+    for r in range(m):
+        p[r], u[r] = 0.0, 0.0
+    for a in range(na):
+        states[a] = 0
     _warm_start(k, na, active, was_closed, p_normal, p_tangent, p)
     if sparse:
-        indptr, indices, blocks = delassus_blocks(na, minv, index, hn, ht, active, s_sparse_ints, s_sparse_floats)
-        floats, ints = fitting_scratch(s_solver_floats, s_solver_ints, na)
-        status, solves, iterations, consistent, fallbacks = two_coefficient_into(
+        nnz = delassus_blocks(na, minv, index, hn, ht, active, s_sparse_ints, s_sparse_floats)
+        indptr, indices, blocks = sparse_views(na, minv.shape[0] // 3, nnz, s_sparse_ints, s_sparse_floats)
+        status, solves, iterations, consistent, fallbacks = two_coefficient_into(  # (pgs_scratch_sizes: it fits)
             solver_code, W, indptr, indices, blocks, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL],
-            iparams[I_MAX_ITER], p, u, states, floats, ints)
+            iparams[I_MAX_ITER], p, u, states, s_solver_floats, s_solver_ints)
     else:  # lemke, enum: one group of coupled contacts at a time (their cost grows with the group)
         status, solves, iterations, consistent, fallbacks = two_coefficient_by_group(
             solver_code, W, q_step, mu_s, mu_d, guess, closing, resting, params[P_RTOL], iparams[I_MAX_ITER], p, u,
@@ -730,6 +750,9 @@ def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
     if m.driven.shape[0] > 0:
         hold_driven_arrays(m.driven, m.motion_now, w.v_free)
     p, u, states = step_impulses(na, scratch.floats, scratch.states)  # (empty without contacts)
+    if not _dense_fits(solver_code, na, m.joints, scratch.W):
+        scratch.need[0], scratch.need[1] = k, na  # _run grows the scratch and redoes this step
+        return RUN_SCRATCH_SHORT
     if na > 0:
         status = solve_arrays(
             solver_code, k, params, iparams, na, qk, vk, m.minv, m.contacts, m.contact_index, m.joints,
@@ -835,20 +858,32 @@ def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
     """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call."""
     # what the loop needs besides the tuples, allocated here: run_arrays counts no references
     f, ring = np.empty(model.minv.shape[0]), np.empty((3, 3, model.contacts.shape[0]))
-    return run_arrays(solver_code, k_start, k_end, params, iparams, extra, step_scratch(solver_code, model), f, ring,
-                      np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64), model, work, out)
+    before = np.empty((3, len(REPEATED_COUNTERS)), dtype=np.int64)
+    scratch = step_scratch(solver_code, model, 0)
+    k = k_start
+    while True:
+        status = run_arrays(solver_code, k_start, k, k_end, params, iparams, extra, scratch, f, ring, before, model,
+                            work, out)
+        if status != RUN_SCRATCH_SHORT:
+            return status
+        # a step with more active contacts than the dense W holds (lemke, enum, joints): room for
+        # twice as many, and the step again from its start (its begin recomputes what it wrote)
+        k = scratch.need[0]
+        scratch = step_scratch(solver_code, model, 2 * scratch.need[1])
 
 
 @jit_borrowing
-def run_arrays(solver_code, k_start, k_end, params, iparams, extra, scratch, f, memory, before, model, work, out):
-    """The loop over the steps on the named data; f: the force's array, memory and before: the
-    rest's ring (below)."""
+def run_arrays(solver_code, k_start, k_first, k_end, params, iparams, extra, scratch, f, memory, before, model, work,
+               out):
+    """The loop over the steps k_first … k_end − 1 of the call that began at k_start, on the named
+    data; f: the force's array, memory and before: the rest's ring (below). Returns a run status
+    (RUN_SCRATCH_SHORT: the step scratch.need[0] needs a larger scratch, _run's)."""
     m, o = model, out
     # The contacts' memory after each of the last three steps and the solver's counters before
     # them (a ring by step): what _fixed_period compares — only where a rest can be repeated (not
     # a time-varying scene, nor the one-step calls of the step-wise loop).
     repeats = iparams[I_TIME_INVARIANT] != 0 and k_end - k_start > 2
-    k = k_start
+    k = k_first
     while k < k_end:
         if repeats:
             for c in range(len(REPEATED_COUNTERS)):
@@ -857,6 +892,8 @@ def run_arrays(solver_code, k_start, k_end, params, iparams, extra, scratch, f, 
         for d in range(extra.shape[0]):
             f[d] += extra[d]
         status = step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch)
+        if status == RUN_SCRATCH_SHORT:
+            return status
         if end_of_step(k, status, o.counters) != RUN_OK:
             return o.counters[K_STATUS]
         if repeats:
@@ -879,7 +916,7 @@ def _after_step(k, k_start, k_end, work, out, memory, before):
     return k
 
 
-@jit
+@jit_borrowing
 def _fixed_period(k, steps_here, q, v, p_normal, p_tangent, memory):
     """1 or 2 when the state step k leaves — q, v, the contacts' memory and the impulses the next
     step warm-starts from — is the one left by step k − 1 (a rest) or k − 2 (a two-step cycle of

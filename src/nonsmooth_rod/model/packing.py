@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 from ..validation import InputError
 from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, C_OFF_AX, C_OFF_AY,  # noqa: F401
                               C_OFF_BX, C_OFF_BY, C_RADIUS_A, C_RADIUS_B, C_RESTITUTION, C_SEGMENT_LENGTH,
@@ -163,7 +163,9 @@ def pack_scene(scene) -> PackedScene:
                        *pack_disk_pairs(table, index), *drives)
 
 
-@jit
+# Borrowing (no reference counting: the step calls these for every contact; they take arrays and
+# return numbers, and allocate nothing).
+@jit_borrowing
 def contact_kinematics(table, index, i, q, v, hn, ht):
     """(gap, Ḣ_N v) of packed contact i; fills its 6-entry Jacobian rows hn, ht."""
     gap, drift_n, _ = kinematics_kernel(index[i, CI_KIND], table[i], index[i, CI_BODY_A], index[i, CI_BODY_B],
@@ -199,7 +201,7 @@ def local_dot(h_row, index, i, x):
     return s
 
 
-@jit
+@jit_borrowing
 def row_dot(rows, index, i, x):
     """local_dot of contact i's row of `rows` (n_contacts × 6), without a view of the row: the
     per-step kernels call it for every contact (a row view costs a reference count)."""

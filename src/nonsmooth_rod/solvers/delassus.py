@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 
 
-@jit
+@jit_borrowing
 def block_nonzero(W, i, j):
     """True when the 2×2 block of contacts i, j of the dense W has a non-zero entry."""
     return (W[2 * i, 2 * j] != 0.0 or W[2 * i, 2 * j + 1] != 0.0
@@ -41,16 +41,32 @@ def dense_to_blocks(W):
 
     Blocks that are exactly zero are left out, except the diagonal ones (always present).
     """
+    indptr = np.zeros(W.shape[0] // 2 + 1, dtype=np.int64)
+    nnz = count_blocks(W, indptr)
+    indices, blocks = np.zeros(nnz, dtype=np.int64), np.zeros((nnz, 2, 2))
+    fill_blocks(W, indptr, indices, blocks)
+    return indptr, indices, blocks
+
+
+@jit_borrowing
+def count_blocks(W, indptr):
+    """dense_to_blocks' row starts (indptr: contacts + 1 entries) in place; returns the blocks'
+    number. With fill_blocks, the conversion into a caller's buffers (borrowing: no allocation)."""
     na = W.shape[0] // 2
-    indptr = np.zeros(na + 1, dtype=np.int64)
+    indptr[0] = 0
     for i in range(na):
         count = 0
         for j in range(na):
             if i == j or block_nonzero(W, i, j):
                 count += 1
         indptr[i + 1] = indptr[i] + count
-    indices = np.zeros(indptr[na], dtype=np.int64)
-    blocks = np.zeros((indptr[na], 2, 2))
+    return indptr[na]
+
+
+@jit_borrowing
+def fill_blocks(W, indptr, indices, blocks):
+    """dense_to_blocks' columns and blocks, for the row starts count_blocks wrote."""
+    na = W.shape[0] // 2
     for i in range(na):
         k = indptr[i]
         for j in range(na):
@@ -60,7 +76,21 @@ def dense_to_blocks(W):
                     for s in range(2):
                         blocks[k, r, s] = W[2 * i + r, 2 * j + s]
                 k += 1
-    return indptr, indices, blocks
+
+
+@jit_borrowing
+def blocks_to_dense(indptr, indices, blocks, W):
+    """The whole dense W from its blocks, into W (2 na × 2 na; group_matrix of every contact,
+    without allocating: pgs's fallback to Lemke in the step's scratch)."""
+    for r in range(W.shape[0]):
+        for c in range(W.shape[1]):
+            W[r, c] = 0.0
+    for a in range(indptr.shape[0] - 1):
+        for k in range(indptr[a], indptr[a + 1]):
+            b = indices[k]
+            for r in range(2):
+                for c in range(2):
+                    W[2 * a + r, 2 * b + c] = blocks[k, r, c]
 
 
 @jit
@@ -117,4 +147,5 @@ def group_matrix(members, W, indptr, indices, blocks):
     return Wg
 
 
-__all__ = ["block_nonzero", "dense_to_blocks", "group_matrix", "coupled_components"]
+__all__ = ["block_nonzero", "dense_to_blocks", "count_blocks", "fill_blocks", "blocks_to_dense", "group_matrix",
+           "coupled_components"]

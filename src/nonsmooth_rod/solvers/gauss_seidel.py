@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_borrowing
 from ._common import make_solution, require_finite_array
 from ..validation import InputError
 from .kernel_base import (
@@ -48,11 +48,12 @@ from .kernel_base import (
     KERNEL_NONFINITE,
     KERNEL_SOLVED,
     all_finite,
+    carve,
     contact_residual,
     problem_scale,
 )
 from .problem import NoConvergence, PlanarFrictionProblem
-from .delassus import coupled_components, dense_to_blocks, group_matrix
+from .delassus import count_blocks, coupled_components, fill_blocks, group_matrix
 from .sticking import gather_contacts
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
@@ -111,7 +112,7 @@ def solve_contact(a, b, c, v_n, v_t, lo, hi):
     return (float(p_n), float(p_t)) if found else None
 
 
-@jit
+@jit_borrowing
 def block_velocities(indptr, indices, blocks, q, p, u):
     """u = W p + q for the block-sparse W, in place (O(nonzero blocks))."""
     for i in range(indptr.shape[0] - 1):
@@ -125,19 +126,17 @@ def block_velocities(indptr, indices, blocks, q, p, u):
         u[2 * i + 1] = u_t
 
 
-@jit
-def _diagonal_positions(indptr, indices):
-    """Position in `blocks` of each contact's diagonal block (−1 if missing)."""
-    na = indptr.shape[0] - 1
-    diagonal = np.full(na, -1, dtype=np.int64)
-    for i in range(na):
+@jit_borrowing
+def _diagonal_positions(indptr, indices, diagonal):
+    """diagonal[i]: the position in `blocks` of contact i's diagonal block (−1 if missing)."""
+    for i in range(indptr.shape[0] - 1):
+        diagonal[i] = -1
         for k in range(indptr[i], indptr[i + 1]):
             if indices[k] == i:
                 diagonal[i] = k
-    return diagonal
 
 
-@jit
+@jit_borrowing
 def pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p):
     """One Gauss–Seidel sweep over the contacts, updating p in place."""
     for i in range(indptr.shape[0] - 1):
@@ -156,26 +155,65 @@ def pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p):
             p[2 * i + 1] = p_t
 
 
+# pgs_block_into's scratch: STALL_SWEEPS floats (the residuals' history) and one int64 per contact
+# (the diagonal blocks' positions); pgs_dense_into's adds the blocks of the dense W (below).
+PGS_FLOATS = STALL_SWEEPS
+
+
+@jit_borrowing
+def _finite_problem(blocks, q, lo, hi, p):
+    """True when the blocks, q, lo, hi and the warm start p are all finite (loops: all_finite's
+    ravel is not for a borrowing caller)."""
+    finite = True
+    for k in range(blocks.shape[0]):
+        for r in range(2):
+            for c in range(2):
+                finite = finite and np.isfinite(blocks[k, r, c])
+    for i in range(q.shape[0]):
+        finite = finite and np.isfinite(q[i]) and np.isfinite(p[i])
+    for i in range(lo.shape[0]):
+        finite = finite and np.isfinite(lo[i]) and np.isfinite(hi[i])
+    return finite
+
+
+@jit_borrowing
+def _unsolved(q, p, u):
+    """p = 0, u = q: what a problem that cannot be solved leaves."""
+    for i in range(q.shape[0]):
+        p[i], u[i] = 0.0, q[i]
+
+
 @jit
 def pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps):
+    """pgs_block_into with scratch of its own (callers outside the step)."""
+    floats, ints = np.empty(PGS_FLOATS), np.empty(max(indptr.shape[0] - 1, 0), dtype=np.int64)
+    return pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, floats, ints)
+
+
+@jit_borrowing
+def pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, floats, ints):
     """Nonsmooth Gauss–Seidel on a block-sparse Delassus; p is the warm start.
 
     Fills p, u in place; returns (status, sweeps, residual) with the `kernels` status codes.
     Stops at residual ≤ rtol·scale. rtol ≤ 0 is the default: aim for PGS_RTOL, and accept a
     stalled residual ≤ DEFAULT_RTOL·scale (module docstring). max_sweeps ≤ 0: PGS_MAX_SWEEPS.
+    floats, ints: scratch of at least PGS_FLOATS and one per contact. Compiled without reference
+    counting (the step's hot path): it allocates nothing (the mode polish, when it runs, does).
     """
-    if not (all_finite(blocks) and all_finite(q) and all_finite(lo) and all_finite(hi) and all_finite(p)):
-        p[:] = 0.0
-        u[:] = q
+    if not _finite_problem(blocks, q, lo, hi, p):
+        _unsolved(q, p, u)
         return KERNEL_NONFINITE, 0, np.inf
-    diagonal = _diagonal_positions(indptr, indices)
+    diagonal, _ = carve(ints, 0, indptr.shape[0] - 1)
+    _diagonal_positions(indptr, indices, diagonal)
     for i in range(diagonal.shape[0]):
         if diagonal[i] < 0:  # the local solve needs W_ii: a malformed matrix cannot converge
             return KERNEL_NO_CONVERGENCE, 0, np.inf
     target = rtol if rtol > 0.0 else PGS_RTOL
     accept = rtol if rtol > 0.0 else DEFAULT_RTOL
     limit = max_sweeps if max_sweeps > 0 else PGS_MAX_SWEEPS
-    history = np.full(STALL_SWEEPS, np.inf)
+    history, _ = carve(floats, 0, STALL_SWEEPS)
+    for s in range(STALL_SWEEPS):
+        history[s] = np.inf
     residual = np.inf
     polish_at = POLISH_FIRST
     for sweep in range(1, limit + 1):
@@ -275,14 +313,44 @@ def polish_modes(indptr, indices, blocks, q, lo, hi, p, u, rtol):
 
 
 @jit
+def pgs_dense_floats(n_contacts):
+    """Floats pgs_dense_into takes for n_contacts contacts: every block of the dense W, and pgs's."""
+    return 4 * n_contacts * n_contacts + PGS_FLOATS
+
+
+@jit
+def pgs_dense_ints(n_contacts):
+    """int64s pgs_dense_into takes: the blocks' row starts and columns, the diagonal's positions."""
+    return n_contacts * n_contacts + 2 * n_contacts + 1
+
+
+@jit
 def pgs_dense(W, q, lo, hi, p, u, rtol, max_sweeps):
-    """`pgs_block` on a dense W (converted once per call, O(contacts²))."""
-    if not all_finite(W):
-        p[:] = 0.0
-        u[:] = q
+    """pgs_dense_into with scratch of its own (callers outside the step)."""
+    na = lo.shape[0]
+    floats, ints = np.empty(pgs_dense_floats(na)), np.empty(pgs_dense_ints(na), dtype=np.int64)
+    return pgs_dense_into(W, q, lo, hi, p, u, rtol, max_sweeps, floats, ints)
+
+
+@jit_borrowing
+def pgs_dense_into(W, q, lo, hi, p, u, rtol, max_sweeps, floats, ints):
+    """`pgs_block_into` on a dense W, its blocks (delassus.dense_to_blocks' layout, O(contacts²))
+    carved from the scratch (floats, ints: at least pgs_dense_floats, pgs_dense_ints of these
+    contacts). Borrowing: it allocates nothing."""
+    na = W.shape[0] // 2
+    finite = True
+    for i in range(W.shape[0]):
+        for j in range(W.shape[1]):
+            finite = finite and np.isfinite(W[i, j])
+    if not finite:
+        _unsolved(q, p, u)
         return KERNEL_NONFINITE, 0, np.inf
-    indptr, indices, blocks = dense_to_blocks(W)
-    return pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps)
+    indptr, at = carve(ints, 0, na + 1)
+    nnz = count_blocks(W, indptr)
+    indices, at = carve(ints, at, nnz)
+    blocks = floats[:4 * nnz].reshape((nnz, 2, 2))
+    fill_blocks(W, indptr, indices, blocks)
+    return pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, floats[4 * nnz:], ints[at:])
 
 
 def projected_gauss_seidel(
@@ -323,6 +391,7 @@ def projected_gauss_seidel(
 
 
 __all__ = [
-    "projected_gauss_seidel", "solve_contact", "local_contact_solve", "pgs_block", "pgs_dense",
+    "projected_gauss_seidel", "solve_contact", "local_contact_solve", "pgs_block", "pgs_block_into", "pgs_dense",
+    "pgs_dense_into", "pgs_dense_floats", "pgs_dense_ints", "PGS_FLOATS",
     "block_velocities", "solve_mode", "polish_modes",
 ]

@@ -96,23 +96,36 @@ def problem_scale(q, p, u) -> float:
 @jit
 def solver_floats(n_contacts):
     """Floats the two-coefficient kernel and Lemke (the cone LCP, 4 unknowns per contact) take for
-    a problem of n_contacts contacts."""
+    a problem of n_contacts contacts (pgs on the dense W takes fewer: gauss_seidel.pgs_dense_floats)."""
     n = n_contacts
     return 52 * n * n + 64 * n + 16
 
 
 @jit
+def solver_ints(n_contacts):
+    """int64s Lemke (8 per contact) or pgs on the dense W (its blocks' columns, n²) take."""
+    n = n_contacts
+    return n * n + 8 * n + 8
+
+
+@jit
 def solver_scratch(n_contacts):
     """(floats, int64s) for a problem of n_contacts contacts."""
-    return np.empty(solver_floats(n_contacts)), np.empty(8 * n_contacts + 8, dtype=np.int64)
+    return np.empty(solver_floats(n_contacts)), np.empty(solver_ints(n_contacts), dtype=np.int64)
 
 
 @jit
 def fitting_scratch(floats, ints, n_contacts):
     """The scratch itself when it holds a problem of n_contacts contacts, else a new one."""
-    if floats.shape[0] >= solver_floats(n_contacts) and ints.shape[0] >= 8 * n_contacts + 8:
+    if fits_scratch(floats, ints, n_contacts):
         return floats, ints
     return solver_scratch(n_contacts)
+
+
+@jit_borrowing
+def fits_scratch(floats, ints, n_contacts):
+    """True when (floats, ints) hold a problem of n_contacts contacts (solver_scratch's sizes)."""
+    return floats.shape[0] >= solver_floats(n_contacts) and ints.shape[0] >= solver_ints(n_contacts)
 
 
 # Inlined: a view made in a borrowing caller (the step's hot path) then counts no reference.

@@ -30,7 +30,7 @@ import numpy as np
 from .._jit import jit, jit_borrowing
 from .enumeration import enum_interval
 from .delassus import dense_to_blocks
-from .gauss_seidel import pgs_block, pgs_dense
+from .gauss_seidel import pgs_block, pgs_block_into, pgs_dense, pgs_dense_into
 from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into
 
 from .kernel_base import (
@@ -50,8 +50,11 @@ from .kernel_base import (
     carve,
     carve_matrix,
     contact_residual,
+    fits_scratch,
     fitting_scratch,
     problem_scale,
+    solver_floats,
+    solver_ints,
     solver_scratch,
     step_residual,
     takes_block_sparse,
@@ -115,13 +118,14 @@ def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
-@jit
-def solve_pgs(W, q, lo, hi, p, u, rtol, max_iter):
-    """pgs_dense behind the common screen."""
+@jit_borrowing
+def solve_pgs_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
+    """pgs_dense_into behind the common screen, in the scratch (floats, ints: kernel_base.solver_scratch
+    of these contacts holds it). Borrowing (the step's dense pgs: a step with joints)."""
     status = _screen(W, q, lo, hi, p, u)
     if status >= 0:
         return _screened(status)
-    return pgs_dense(W, q, lo, hi, p, u, rtol, max_iter)
+    return pgs_dense_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
 @jit
@@ -139,12 +143,12 @@ def solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats,
     (registry.SOLVERS), Lemke in the scratch (floats, ints). One branch per compiled solver of
     the table — numba calls a kernel by its name, not out of a table; the loop reads the code at
     run time, so every solver compiles into the one loop. Fills p, u in place; returns (status,
-    iterations, residual) (module docstring). Borrowing (the step's hot path): Lemke's scratch
-    must fit these contacts (fitting_scratch in the counting caller)."""
+    iterations, residual) (module docstring). Borrowing (the step's hot path): the scratch
+    must fit these contacts (solver_scratch's sizes: fitting_scratch in the counting caller)."""
     if solver_code == SOLVER_LEMKE:
         return solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     if solver_code == SOLVER_PGS:
-        return solve_pgs(W, q, lo, hi, p, u, rtol, max_iter)
+        return solve_pgs_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     if solver_code == SOLVER_ENUM:
         return solve_enum(W, q, lo, hi, p, u, rtol, max_iter)
     for i in range(q.shape[0]):  # an unknown solver code: nothing solved
@@ -154,13 +158,13 @@ def solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats,
 
 @jit
 def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval_into with scratch of its own (Lemke's; the other solvers need none)."""
-    floats, ints = solver_scratch(lo.shape[0] if solver_code == SOLVER_LEMKE else 0)
+    """solve_interval_into with scratch of its own (Lemke's and pgs's; enum needs none)."""
+    floats, ints = solver_scratch(lo.shape[0] if solver_code != SOLVER_ENUM else 0)
     return solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
 __all__ = [
     "KERNEL_SOLVED", "KERNEL_RAY", "KERNEL_NO_CONVERGENCE", "KERNEL_TOO_LARGE", "KERNEL_NONFINITE",
     "SOLVER_LEMKE", "SOLVER_PGS", "SOLVER_ENUM", "SOLVER_CODES", "BLOCK_SPARSE_CODES", "STATUS_NAMES", "DEFAULT_RTOL",
-    "solve_interval", "solve_interval_into", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs", "solve_enum", "lemke_interval", "pgs_block", "pgs_dense", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite", "takes_block_sparse",
+    "solve_interval", "solve_interval_into", "solve_lemke_into", "solver_scratch", "fitting_scratch", "carve", "carve_matrix", "solve_pgs_into", "solve_enum", "lemke_interval", "pgs_block", "pgs_block_into", "pgs_dense", "pgs_dense_into", "fits_scratch", "solver_floats", "solver_ints", "dense_to_blocks", "enum_interval", "step_residual", "contact_residual", "problem_scale", "all_finite", "takes_block_sparse",
 ]

@@ -27,19 +27,23 @@ from .. import solvers as _solvers
 from .._jit import jit, jit_borrowing
 # The solver call point: the compiled kernels (registry.SOLVERS with a code); the QP solvers stay
 # Python (solve_two_coefficient below).
-from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fitting_scratch, lemke_interval,
-                      pgs_block, solve_interval_into, solver_scratch)
+from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fits_scratch, fitting_scratch,
+                      lemke_interval, pgs_block_into, solve_interval_into, solver_floats, solver_ints)
+from .gauss_seidel import PGS_FLOATS
 from ._common import interpreted
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
                       PlanarFrictionProblem, SolverError)
 from .registry import DEFAULT_SOLVER
-from .delassus import coupled_components, group_matrix
+from .delassus import blocks_to_dense, coupled_components, group_matrix
 from .sticking import gather_contacts, prefer_sticking_by_group, scatter_contacts
 
 STATE_NAMES = CONTACT_STATES  # (the codes' names, problem.py)
 # What the sign iteration does after a solve that was not consistent.
 NEXT_RETRY, NEXT_TRY_ZERO, NEXT_STOP = 0, 1, 2
 MAX_SOLVES = 6
+# Floats per contact the sign iteration carves before the solver's part (two_coefficient_into:
+# the start guess, the warm start's two, lo, hi, the new guess, MAX_SOLVES + 1 tried guesses).
+SIGN_ITERATION_FLOATS = 6 + MAX_SOLVES + 1
 
 
 @dataclass
@@ -136,19 +140,41 @@ MAX_DENSE_HOLD = 64
 
 
 @jit
+def pgs_scratch_sizes(n_contacts):
+    """(floats, int64s) two_coefficient_into takes on a block-sparse W of up to n_contacts active
+    contacts: the sign iteration's, then pgs's (the stall history, one int per contact) or its
+    fallback's (the dense W and Lemke's scratch, up to MAX_DENSE_HOLD contacts). What the loop's
+    per-run scratch holds for pgs (moreau_jean_loop.step_scratch), whatever the active set."""
+    m = min(n_contacts, MAX_DENSE_HOLD)
+    floats = SIGN_ITERATION_FLOATS * n_contacts + max(PGS_FLOATS, 4 * m * m + solver_floats(m))
+    return floats, max(n_contacts, solver_ints(m))
+
+
+@jit
 def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback):
+    """pgs_or_lemke_into with scratch of its own (callers outside the step)."""
+    n_floats, n_ints = pgs_scratch_sizes(lo.shape[0])
+    return pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback, np.empty(n_floats),
+                             np.empty(n_ints, dtype=np.int64))
+
+
+@jit_borrowing
+def pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback, floats, ints):
     """pgs on the block-sparse W; with `fallback`, a step it cannot solve with at most
     MAX_DENSE_HOLD contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
     singular W (a pile: many coupled contacts, q a little outside W's range) just above its
     acceptance, where Lemke's pivoting is exact. Returns (status, sweeps + pivots, residual,
-    1 if it fell back else 0)."""
-    status, sweeps, residual = pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
+    1 if it fell back else 0). In the scratch (floats, ints: the solver's part of pgs_scratch_sizes
+    — the dense W and Lemke's buffers of the fallback included); borrowing: it allocates nothing."""
+    status, sweeps, residual = pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     na = lo.shape[0]
     if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
         return status, sweeps, residual, 0
-    W = group_matrix(np.arange(na), np.zeros((0, 0)), indptr, indices, blocks)  # the whole W, dense
-    floats, ints = solver_scratch(na)
-    status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0, floats, ints)  # Lemke's own acceptance
+    if floats.shape[0] < 4 * na * na + solver_floats(na) or ints.shape[0] < solver_ints(na):
+        return status, sweeps, residual, 0  # (a caller's scratch without room for it: pgs's answer stands)
+    W, at = carve_matrix(floats, 0, 2 * na, 2 * na)  # the whole W, dense
+    blocks_to_dense(indptr, indices, blocks, W)
+    status, pivots, residual = lemke_interval(W, q, lo, hi, p, u, 0.0, 0, floats[at:], ints)  # Lemke's own acceptance
     return status, sweeps + pivots, residual, 1
 
 
@@ -160,11 +186,12 @@ def _defaults(rtol, max_iter):
 
 @jit_borrowing
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
-    """solve_interval_into on the dense W (in the scratch floats, ints), or pgs_or_lemke when the
-    block-sparse W is given (indptr). Returns (status, iterations, residual, 1 if pgs fell back
+    """solve_interval_into on the dense W, or pgs_or_lemke_into when the block-sparse W is given
+    (indptr), in the scratch floats, ints. Returns (status, iterations, residual, 1 if pgs fell back
     to Lemke else 0)."""
     if indptr.shape[0] > 0:
-        return pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter))
+        return pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter),
+                                 floats, ints)
     status, iterations, residual = solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     return status, iterations, residual, 0
 
@@ -175,23 +202,31 @@ def _guess_of_states(states, guess):
         guess[i] = 1.0 if states[i] == STATE_SLIP_PLUS else (-1.0 if states[i] == STATE_SLIP_MINUS else 0.0)
 
 
-@jit
+@jit_borrowing
 def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
                  states, p_start):
     """Hold what μs can hold (sticking.prefer_sticking, group by group of coupled contacts) when a
     contact that started the step at rest — slip velocity round-off at the step's start
     (`resting` 1), slip guess 0 — does not stick; True when p, u, states were replaced. The
-    common step returns at once. A contact that was already sliding (or grazing a rolling
-    neighbour) keeps the solver's answer: the search costs milliseconds on rows of balls and has
-    nothing to hold there. Groups of more than MAX_DENSE_HOLD contacts keep the solver's split.
-    p_start: the previous step's impulses (the warm start), or empty."""
-    na = mu_s.shape[0]
+    common step returns at once (borrowing: it counts and allocates nothing). A contact that was
+    already sliding (or grazing a rolling neighbour) keeps the solver's answer: the search costs
+    milliseconds on rows of balls and has nothing to hold there. Groups of more than MAX_DENSE_HOLD
+    contacts keep the solver's split. p_start: the previous step's impulses (the warm start), or empty."""
     moving = False
-    for i in range(na):
+    for i in range(mu_s.shape[0]):
         if resting[i] > 0.0 and start_guess[i] == 0.0 and states[i] != STATE_STICK:
             moving = True
-    if not moving:  # the common step: nothing to search, nothing allocated
+    if not moving:  # the common step: nothing to search
         return False
+    return _hold_search(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
+                        states, p_start)
+
+
+@jit
+def _hold_search(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
+                 states, p_start):
+    """hold_at_rest's search (counted: it allocates)."""
+    na = mu_s.shape[0]
     at_rest = np.empty(na)
     for i in range(na):
         at_rest[i] = start_guess[i] if resting[i] > 0.0 else 2.0  # 2: not a candidate
@@ -202,8 +237,10 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
 @jit
 def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting, rtol,
                            max_iter, p, u, states):
-    """two_coefficient_into with scratch of its own."""
-    floats, ints = solver_scratch(guess.shape[0])
+    """two_coefficient_into with scratch of its own (Lemke's, or pgs's with its fallback)."""
+    na = guess.shape[0]
+    n_floats, n_ints = pgs_scratch_sizes(na) if indptr.shape[0] > 0 else (solver_floats(na), solver_ints(na))
+    floats, ints = np.empty(n_floats), np.empty(n_ints, dtype=np.int64)
     return two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting,
                                 rtol, max_iter, p, u, states, floats, ints)
 
@@ -218,7 +255,8 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
     1 for a contact whose slip velocity at the step's start is round-off. Once the
     sign iteration is consistent, a contact that started at rest slides only if no admissible
     impulse split holds it (hold_at_rest). floats, ints: scratch (kernel_base.solver_scratch
-    for at least these contacts: the caller's fitting_scratch).
+    for at least these contacts — the caller's fitting_scratch —, pgs_scratch_sizes' on the
+    block-sparse W).
     Returns (kernel status, solves, solver iterations, consistent, pgs steps solved again by Lemke).
     Compiled without reference counting (the step's hot path): it allocates nothing."""
     na = guess.shape[0]
@@ -271,7 +309,7 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
 GROUP_MIN_CONTACTS = 4
 
 
-@jit
+@jit_borrowing
 def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states,
                              floats, ints):
     """two_coefficient_into on a dense W one group of coupled contacts at a time: W is
@@ -281,7 +319,21 @@ def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, rest
     group no longer resets the guesses of another. Steps of at most GROUP_MIN_CONTACTS contacts
     are solved whole. floats, ints: the scratch (kernel_base.solver_scratch). The same returns
     as two_coefficient_kernel (solves, iterations and fallbacks summed; consistent when every
-    group is)."""
+    group is). Borrowing for the common step (few contacts, in the scratch); the split, and a step
+    beyond the scratch, go to _by_group_split, which allocates."""
+    na = mu_s.shape[0]
+    if na <= GROUP_MIN_CONTACTS and fits_scratch(floats, ints, na):
+        empty, no_blocks = ints[:0], floats[:0].reshape((0, 2, 2))  # no sparse W (views: nothing allocated)
+        return two_coefficient_into(solver_code, W, empty, empty, no_blocks, q, mu_s, mu_d, guess, closing, resting,
+                                    rtol, max_iter, p, u, states, floats, ints)
+    return _by_group_split(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states,
+                           floats, ints)
+
+
+@jit
+def _by_group_split(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states, floats,
+                    ints):
+    """two_coefficient_by_group's split (counted: its groups' arrays are allocated)."""
     na = mu_s.shape[0]
     floats, ints = fitting_scratch(floats, ints, na)  # (the groups are smaller: it fits them too)
     empty, no_blocks = ints[:0], floats[:0].reshape((0, 2, 2))  # no sparse W (views: nothing allocated)
@@ -362,6 +414,7 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
                              float(sol.residual), consistent)
 
 
-__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_into", "two_coefficient_by_group", "StepContactResult",
+__all__ = ["solve_two_coefficient", "two_coefficient_kernel", "two_coefficient_into", "two_coefficient_by_group", "pgs_or_lemke_into",
+           "pgs_scratch_sizes", "StepContactResult",
            "classify_solution",
            "next_action", "SolverError", "STATE_NAMES"]
