@@ -617,12 +617,11 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
         p_normal[k, i] = 0.0
         p_tangent[k, i] = 0.0
         state_rec[k, i] = 0
+        grazing[i] = 0
         if not broad or candidate[i]:
             slip[k, i] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
         else:  # a contact out of reach has zero rows: only the belt's surface velocity is left
             slip[k, i] = -table[i, C_SURFACE_VELOCITY]
-    for i in range(table.shape[0]):
-        grazing[i] = 0
     for a in range(na):
         i = active[a]
         p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]

@@ -130,21 +130,25 @@ def _interval_of(mu_s, mu_d, guess, lo, hi):
 
 
 # Statically indeterminate holds are searched on a dense W per group of coupled contacts; a
-# group larger than this (a pile of hundreds of disks) keeps the solver's split. pgs steps of at
-# most this many contacts that Gauss–Seidel cannot finish are solved again by Lemke.
+# group larger than this (a pile of hundreds of disks) keeps the solver's split.
 MAX_DENSE_HOLD = 64
+# pgs steps of at most this many active contacts that Gauss–Seidel cannot finish are solved
+# again by Lemke on the dense W (a rare step: its W of (2 × 256)² floats is 2 MB). With the
+# limit at MAX_DENSE_HOLD, the heap of 50 boxes (toys.BoxHeap, seed 1) stopped at t = 0.261 s
+# on a step of more active contacts that Gauss–Seidel could not finish.
+MAX_LEMKE_FALLBACK = 256
 
 
 @jit
 def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback):
     """pgs on the block-sparse W; with `fallback`, a step it cannot solve with at most
-    MAX_DENSE_HOLD contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
+    MAX_LEMKE_FALLBACK contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
     singular W (a pile: many coupled contacts, q a little outside W's range) just above its
     acceptance, where Lemke's pivoting is exact. Returns (status, sweeps + pivots, residual,
     1 if it fell back else 0)."""
     status, sweeps, residual = pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter)
     na = lo.shape[0]
-    if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
+    if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_LEMKE_FALLBACK:
         return status, sweeps, residual, 0
     W = group_matrix(np.arange(na), np.zeros((0, 0)), indptr, indices, blocks)  # the whole W, dense
     floats, ints = solver_scratch(na)
