@@ -1,5 +1,6 @@
 """The broad phase: listing every disk pair changes nothing but the listing."""
 import numpy as np
+import pytest
 
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.model.body import RigidBody
@@ -47,3 +48,90 @@ def test_disk_pairs_are_packed_once_per_disk_and_sorted():
     packed = pack_scene(_row(4, True)[0])
     assert packed.disks.shape == (4, 3) and list(packed.disk_body) == [1, 0, 2, 3]  # first seen: body_a of 0-1
     assert np.all(np.diff(packed.pair_keys) > 0) and len(packed.pair_keys) == 6
+
+
+def _boxes_on_a_floor(n, seed):
+    """n boxes of found contacts (every pair, and each on the floor) placed near each other at
+    random — within a box's size, some overlapping — with random velocities up to 30 m/s and
+    30 rad/s, and their packed scene."""
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.model.collision import find_contacts
+
+    rng = np.random.default_rng(seed)
+    bodies = [RigidBody(1.0, 0.02, f"box{k}") for k in range(n)]
+    shapes = {b.name: nr.Polygon.rectangle(0.4, 0.3) for b in bodies}
+    contacts = find_contacts(bodies, shapes, {"floor": Line()})
+    q = np.column_stack([rng.uniform(-0.4, 0.4, n), rng.uniform(-0.1, 0.6, n), rng.uniform(-np.pi, np.pi, n)])
+    v = rng.uniform(-30.0, 30.0, (n, 3))
+    return pack_scene(Scene(bodies, contacts)), q.ravel(), v.ravel()
+
+
+def _candidates(packed, q, v, h, sweep):
+    from nonsmooth_rod.integrators import moreau_jean_loop as loop
+
+    n, nc = packed.disks.shape[0], packed.n_contacts
+    x, y, reach = np.empty(n), np.empty(n), np.empty(n)
+    loop._disk_reach(h, q, v, packed.disks, packed.disk_body, x, y, reach, np.empty(q.size))
+    candidate, was_closed = np.ones(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64)
+    if sweep:
+        order = np.argsort(y)
+        loop._sweep_and_prune(y, x, reach, order, packed.disk_body, packed.pair_keys, packed.pair_contact,
+                              was_closed, candidate)
+    else:
+        loop._listed_pairs_in_reach(x, y, reach, packed.pair_keys, packed.pair_contact, was_closed, candidate)
+    loop.lines_in_reach(0.5 * h, q, v, packed.contacts, packed.contact_index, was_closed, candidate)
+    return candidate
+
+
+def test_the_broad_phase_leaves_out_no_contact_the_step_activates():
+    """Exactness of the pre-tests before the kinematics: whichever way the circles' pairs are
+    tested (each listed pair, or sweep and prune), and for a point on the line, every contact
+    whose activation test (predicted gap γ h ahead ≤ the round-off margin) holds this step is
+    kept — fast bodies close to each other included — and both ways keep the same contacts."""
+    from nonsmooth_rod.integrators.moreau_jean_loop import ACTIVATION_ROUNDOFF
+    from nonsmooth_rod.model.packing import contact_kinematics, row_dot
+
+    h, gamma, activated, left_out = 1e-2, 0.5, 0, 0
+    for seed in range(12):
+        packed, q, v = _boxes_on_a_floor(4, seed)
+        listed, swept = _candidates(packed, q, v, h, False), _candidates(packed, q, v, h, True)
+        assert np.array_equal(listed, swept)
+        hn, ht = np.zeros((packed.n_contacts, 6)), np.zeros((packed.n_contacts, 6))
+        for i in range(packed.n_contacts):
+            gap, _ = contact_kinematics(packed.contacts, packed.contact_index, i, q, v, hn[i], ht[i])
+            if gap + gamma * h * row_dot(hn, packed.contact_index, i, v) <= ACTIVATION_ROUNDOFF:
+                activated += 1
+                assert listed[i] == 1, (seed, i)
+        left_out += int(np.sum(listed == 0))
+    assert activated > 50 and left_out > 100  # the check has cases on both sides
+
+
+def test_fast_boxes_do_not_pass_through_the_floor_or_each_other():
+    """A box thrown at 40 m/s (4 cm a step) into a box at rest, and one dropped at 40 m/s onto the
+    floor, found contacts: the pre-tests leave out the far pairs, never the ones the step needs —
+    the thrown box strikes the resting one and stays behind it (equal masses, e = 0: they go on
+    together at 20 m/s, less what the floor's friction takes), the dropped one lands on its face.
+    The scheme's own bound on a penetration is one step's travel: a contact enters the step when
+    its gap is within γ h |u_N| (it may be up to (1 − γ) h |u_N| deep then), and the θ-method's
+    positions go on (1 − θ) h |u_N| before the impact stops them (γ = θ = 1/2): 4 cm at 40 m/s
+    (a pass-through: 30 or 40 cm)."""
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.model.collision import deepest_overlap, find_contacts
+
+    bodies = [RigidBody(1.0, 0.02, name) for name in ("still", "thrown", "dropped")]
+    shapes = {b.name: nr.Polygon.rectangle(0.4, 0.3) for b in bodies}
+    law = ContactLaw.of(0.1, 0.1)
+    contacts = find_contacts(bodies, shapes, {"floor": Line()}, nr.PairLaws(default=law))
+    q0 = np.array([0.0, 0.15, 0.0, -1.0, 0.15, 0.0, 3.0, 1.15, 0.0])
+    v0 = np.array([0.0, 0.0, 0.0, 40.0, 0.0, 0.0, 0.0, -40.0, 0.0])
+    h, speed = 1e-3, 40.0
+    result = nr.simulate(Scene(bodies, contacts), q0, v0, 0.04, "moreau-jean", h=h)
+    assert result.status == "ok", result.message
+    q, v = result.trajectory.q, result.trajectory.v
+    deepest = h * (speed + 9.81 * 0.04)  # the step's travel at the fastest (gravity adds 0.4 m/s)
+    assert np.max(q[:, 3] + 0.4 - q[:, 0]) <= deepest  # the thrown box stays behind the struck one's face
+    assert v[-1, 0] == pytest.approx(20.0, abs=0.1) and v[-1, 3] == pytest.approx(v[-1, 0], abs=1e-6)
+    assert abs(q[-1, 7] - 0.15) <= deepest and v[-1, 7] == pytest.approx(0.0, abs=1e-9)
+    assert deepest_overlap(bodies, shapes, q, [Line()]) <= deepest
+    struck = {frozenset(side.split(".")[0] for side in i.contact.split("/")) for i in result.impacts}
+    assert {frozenset({"still", "thrown"}), frozenset({"dropped", "floor"})} <= struck

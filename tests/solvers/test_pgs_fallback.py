@@ -2,7 +2,7 @@
 
 Gauss–Seidel drifts along the null space of a singular W and can stall just above its
 acceptance (a pile of disks: tens of coupled, statically indeterminate contacts). Such a step,
-with at most MAX_DENSE_HOLD contacts, is handed to Lemke; the run counts it in
+with at most MAX_LEMKE_FALLBACK contacts, is handed to Lemke; the run counts it in
 stats["solver_fallbacks"] and goes on. A user who set pgs's own sweep limit or tolerance gets
 pgs alone (its failure is reported: tests/integrators/test_solver_failure_report.py).
 """
@@ -18,7 +18,7 @@ from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.solvers.delassus import dense_to_blocks
 from nonsmooth_rod.solvers.kernels import KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, pgs_block
 from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity_residual, residual_scale
-from nonsmooth_rod.solvers.two_coefficient import pgs_or_lemke
+from nonsmooth_rod.solvers.two_coefficient import MAX_DENSE_HOLD, MAX_LEMKE_FALLBACK, pgs_or_lemke
 from nonsmooth_rod.toys.stacks import disk_pile
 from solver_cases import block_on_incline
 
@@ -39,6 +39,28 @@ def test_a_step_one_sweep_leaves_unsolved_is_solved_by_the_fallback():
     scale = residual_scale(problem, p, u)
     assert complementarity_residual(problem, p) <= 1e-12 * scale
     np.testing.assert_allclose(u, problem.W @ p + problem.q, rtol=0, atol=1e-13 * scale)
+
+
+def test_a_step_of_more_than_64_contacts_falls_back_too():
+    """40 blocks on inclines at once (80 contacts, beyond the hold search's 64): one sweep leaves
+    them unsolved and Lemke on the whole dense W solves them (the heap of 50 boxes stopped on such
+    a step, seed 1 at t = 0.261 s, while the fallback stopped at 64)."""
+    from scipy.linalg import block_diag
+
+    one = block_on_incline(0.3, 0.5)
+    n = 40
+    W, q = block_diag(*[one.W] * n), np.tile(one.q, n)
+    lo, hi = np.tile(one.lo, n), np.tile(one.hi, n)
+    assert MAX_DENSE_HOLD < 2 * n <= MAX_LEMKE_FALLBACK
+    indptr, indices, blocks = dense_to_blocks(W)
+    p, u = np.zeros(q.size), q.copy()
+    status, _, _, fell_back = pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, 0.0, 1, True)
+    assert (status, fell_back) == (KERNEL_SOLVED, 1)
+    p_one, u_one = np.zeros(4), one.q.copy()
+    pgs_or_lemke(*dense_to_blocks(one.W), one.q, one.lo, one.hi, p_one, u_one, 0.0, 1, True)
+    scale = float(np.max(np.abs(np.r_[p, u, q])))
+    np.testing.assert_allclose(p, np.tile(p_one, n), rtol=0, atol=1e-12 * scale)  # each block's own answer
+    np.testing.assert_allclose(u, W @ p + q, rtol=0, atol=1e-13 * scale)
 
 
 def test_a_converged_pgs_step_does_not_fall_back():

@@ -30,7 +30,8 @@ from .._jit import jit, jit_borrowing
 
 
 _inlined = _jit.jit_inline  # the small per-contact helpers, compiled into the step's functions
-from ..model.contact_kernels import (C_OBSTACLE_START_VX, C_OBSTACLE_VX, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
+from ..model.contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
+                                      C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
                                       KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
 from ..model.forces import accumulate_forces
 from ..model.joints import ROWS_PER_JOINT, jointed_dofs
@@ -54,6 +55,10 @@ PERSISTENCE_FACTOR = 4.0
 # edges, segments) than this: for a few, sorting the circles costs more than the kinematics it
 # saves (measured: row of two balls 3.7 → 3.6 µs).
 BROAD_PHASE_MIN_PAIRS = 8
+# The broad phase tests each listed circle pair when there are at most this many per circle
+# (cheaper than sorting and looking pairs up: a tower of 5 boxes lists 320 on 40 circles), and
+# sweeps the sorted circles beyond (a heap of 50 boxes lists ~40 000 on ~400).
+PAIRS_PER_CIRCLE_TESTED = 16
 # Added to every disk's reach in the broad phase (m): contacts placed exactly touching.
 BROAD_PHASE_SLACK = 1e-9
 # A contact closes "with approaching velocity" when u_N before the step is below this.
@@ -166,15 +171,18 @@ def persistence_margin(h, drift, free_acceleration):
 
 
 @jit
-def _disk_reach(h, q, v, disks, disk_body, x, y, reach):
-    """World centres of the disks and how far each can reach this step (radius + h · speed)."""
+def _disk_reach(h, q, v, disks, disk_body, x, y, reach, turn):
+    """World centres of the disks and how far each can reach this step (radius + h · speed);
+    turn: scratch for each body's (cos θ, sin θ), computed once for all of its circles."""
+    for body in range(q.shape[0] // 3):
+        turn[2 * body], turn[2 * body + 1] = math.cos(q[3 * body + 2]), math.sin(q[3 * body + 2])
     for d in range(disks.shape[0]):
         ox, oy = disks[d, 0], disks[d, 1]
         if disk_body[d] < 0:  # a fixed circle (a segment, a segment's end)
             x[d], y[d], reach[d] = ox, oy, disks[d, 2] + BROAD_PHASE_SLACK
             continue
         j = 3 * disk_body[d]
-        c, s = math.cos(q[j + 2]), math.sin(q[j + 2])
+        c, s = turn[2 * disk_body[d]], turn[2 * disk_body[d] + 1]
         x[d] = q[j] + c * ox - s * oy
         y[d] = q[j + 1] + s * ox + c * oy
         # the fastest point of the circle: an edge's end turns faster than its middle
@@ -183,20 +191,67 @@ def _disk_reach(h, q, v, disks, disk_body, x, y, reach):
         reach[d] = disks[d, 2] + h * speed + BROAD_PHASE_SLACK
 
 
+@_inlined
+def _in_reach(x, y, reach, da, db):
+    """Whether circles da and db can meet this step (their centres within both reaches, per axis)."""
+    both = reach[da] + reach[db]
+    return abs(x[db] - x[da]) <= both and abs(y[db] - y[da]) <= both
+
+
+@_inlined
+def _first_at_least(keys, key):
+    """The first position of the sorted keys holding key or more (np.searchsorted's left side,
+    inlined: most circle pairs in reach — a vertex on a vertex, an edge on an edge — join no
+    contact, and the call cost more than the search)."""
+    lo, hi = 0, keys.shape[0]
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if keys[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
 @jit
 def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate):
-    """Mark the contacts that can act this step: sort the feature circles (packing.pack_disk_pairs)
-    along x, and test only pairs whose centres are within their reach (sweep and prune), plus
-    the contacts closed last step and those outside the broad phase (on lines).
-    O(circles log circles + pairs in reach), whatever the number of listed contacts."""
+    """Mark the contacts that can act this step: the contacts closed last step, those outside the
+    broad phase (on lines: lines_in_reach), and those whose two feature circles
+    (packing.pack_disk_pairs) are within their reach. With few listed pairs per circle (a tower,
+    a row of dominoes) each listed pair is tested; otherwise the circles are swept and pruned
+    (_sweep_and_prune, O(circles log circles + pairs in reach)). Both mark the same contacts."""
     n = disks.shape[0]
-    x, y, reach = np.empty(n), np.empty(n), np.empty(n)
-    _disk_reach(h, q, v, disks, disk_body, x, y, reach)
+    x, y, reach, turn = np.empty(n), np.empty(n), np.empty(n), np.empty(q.shape[0])
+    _disk_reach(h, q, v, disks, disk_body, x, y, reach, turn)
     for i in range(candidate.shape[0]):
         candidate[i] = 1
+    if pair_keys.shape[0] <= PAIRS_PER_CIRCLE_TESTED * n:
+        _listed_pairs_in_reach(x, y, reach, pair_keys, pair_contact, was_closed, candidate)
+        return
+    along, across = (y, x) if np.max(y) - np.min(y) > np.max(x) - np.min(x) else (x, y)
+    _sweep_and_prune(along, across, reach, np.argsort(along), disk_body, pair_keys, pair_contact, was_closed,
+                     candidate)
+
+
+@jit_borrowing
+def _listed_pairs_in_reach(x, y, reach, pair_keys, pair_contact, was_closed, candidate):
+    """Mark each listed circle pair's contact that was closed or is in reach (key: a n + b)."""
+    n = x.shape[0]
+    for j in range(pair_contact.shape[0]):
+        da = pair_keys[j] // n
+        i = pair_contact[j]
+        candidate[i] = 1 if was_closed[i] or _in_reach(x, y, reach, da, pair_keys[j] - da * n) else 0
+
+
+@jit_borrowing
+def _sweep_and_prune(along, across, reach, order, disk_body, pair_keys, pair_contact, was_closed, candidate):
+    """Mark the contacts closed last step and those of the circle pairs in reach: the circles in
+    `order` along the axis they spread most on (a tower's y, a row's x: the same pairs are found
+    on either, the widest prunes most), each swept against the next ones until out of reach; one
+    body's own circles skipped (no contact joins them: packing)."""
+    n = along.shape[0]
     for j in range(pair_contact.shape[0]):
         candidate[pair_contact[j]] = was_closed[pair_contact[j]]
-    order = np.argsort(x)
     widest = 0.0  # circles of different sizes (a vertex, an edge): stop the sweep at the widest's reach
     for d in range(n):
         widest = max(widest, reach[d])
@@ -204,15 +259,35 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
         da = order[a]
         for b in range(a + 1, n):
             db = order[b]
-            if x[db] - x[da] > reach[da] + widest:
+            if along[db] - along[da] > reach[da] + widest:
                 break
-            if abs(x[db] - x[da]) > reach[da] + reach[db] or abs(y[db] - y[da]) > reach[da] + reach[db]:
+            if disk_body[da] == disk_body[db] or not _in_reach(along, across, reach, da, db):
                 continue
             key = min(da, db) * n + max(da, db)
-            j = np.searchsorted(pair_keys, key)
+            j = _first_at_least(pair_keys, key)
             while j < pair_keys.shape[0] and pair_keys[j] == key:
                 candidate[pair_contact[j]] = 1
                 j += 1
+
+
+@jit_borrowing
+def lines_in_reach(reach_time, q, v, table, index, was_closed, candidate):
+    """Leave out of this step a point or disk of a body on a line (infinite: not among the broad
+    phase's circles) that cannot enter the step: the body's centre farther from the line than the
+    disk's lever and radius plus what its fastest point and the line close in `reach_time`
+    (γ h: the activation test's predicted gap, bounded below without the kinematics). A contact
+    closed in the last step always enters the kinematics (its persistence margin)."""
+    for i in range(table.shape[0]):
+        if index[i, CI_KIND] != KIND_DISK_ON_LINE or was_closed[i]:
+            continue
+        j = 3 * index[i, CI_BODY_A]
+        ox, oy = table[i, C_OFF_AX], table[i, C_OFF_AY]
+        wx, wy = table[i, C_OBSTACLE_START_VX], table[i, C_OBSTACLE_START_VY]
+        lever = math.sqrt(ox * ox + oy * oy)
+        centre = table[i, C_NX] * (q[j] - table[i, C_LINE_PX]) + table[i, C_NY] * (q[j + 1] - table[i, C_LINE_PY])
+        speed = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1]) + abs(v[j + 2]) * lever + math.sqrt(wx * wx + wy * wy)
+        if centre - lever - table[i, C_RADIUS_A] - reach_time * speed > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK:
+            candidate[i] = 0
 
 
 @jit_borrowing
@@ -261,13 +336,17 @@ def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_k
     broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
     if broad:
         broad_phase(h, qk, vk, disks, disk_body, pair_keys, pair_contact, was_closed, candidate)
+        lines_in_reach(h * abs(gamma), qk, vk, table, index, was_closed, candidate)
     na = 0
     for i in range(table.shape[0]):
         if broad and not candidate[i]:
-            gaps[i], drifts[i] = math.inf, 0.0  # out of reach this step: no kinematics
-            for d in range(6):  # element by element: a row slice costs more, per listed contact
-                hn[i, d] = 0.0
-                ht[i, d] = 0.0
+            # out of reach this step: no kinematics. An infinite gap comes with zero rows (a pair
+            # the kernel rejects gets them too): rows already zeroed are not written again.
+            if gaps[i] != math.inf:
+                for d in range(6):  # element by element: a row slice costs more, per listed contact
+                    hn[i, d] = 0.0
+                    ht[i, d] = 0.0
+            gaps[i], drifts[i] = math.inf, 0.0
             continue
         gap, drift = contact_kinematics(table, index, i, qk, vk, hn[i], ht[i])
         if math.isnan(gap):
@@ -276,6 +355,8 @@ def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_k
         if depth > 0.0 and gap < -depth:
             return -1 - table.shape[0] - i
         gaps[i], drifts[i] = gap, drift
+        if gap == math.inf:  # not the touching pair of features (zero rows): never active
+            continue
         predicted = gap + gamma * h * relative_normal_velocity(table, hn, ht, index, i, vk, True)
         margin = ACTIVATION_ROUNDOFF
         if was_closed[i]:
@@ -546,12 +627,11 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
         p_normal[k, i] = 0.0
         p_tangent[k, i] = 0.0
         state_rec[k, i] = 0
+        grazing[i] = 0
         if not broad or candidate[i]:
             slip[k, i] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
         else:  # a contact out of reach has zero rows: only the belt's surface velocity is left
             slip[k, i] = -table[i, C_SURFACE_VELOCITY]
-    for i in range(table.shape[0]):
-        grazing[i] = 0
     for a in range(na):
         i = active[a]
         p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]

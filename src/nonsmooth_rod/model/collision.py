@@ -6,8 +6,9 @@ model.contacts' `Line` (infinite) and `Segment`; `Polyline` is a chain of segmen
 
 `find_contacts(bodies, shapes, obstacles, ...)` lists, for every pair of collidable shapes, the
 candidate contacts between their features (the narrow phase is each candidate's kernel, run
-every step: a candidate whose features do not touch has an infinite or positive gap and stays
-open; model/contact_kernels.py):
+every step the broad phase keeps it — moreau_jean_loop.broad_phase, lines_in_reach: a candidate
+whose features do not touch has an infinite or positive gap and stays open;
+model/contact_kernels.py):
 
     polygon – polygon   every vertex of each on every edge of the other (VertexOnEdge)
     polygon – line      every vertex on the line (a DiskOnLine of radius 0)

@@ -283,7 +283,7 @@ def _vertex_on_edge(row, point_body, edge_body, q, v, hn, ht):
     of `edge_body` (−1: fixed), the edge's outward normal n = τ turned by −90° (a CCW outline).
     Gap n·(P − E) − r; the edge's touching point is the foot Q = E + (τ·(P − E)) τ. An infinite
     gap: the pair is not the touching one (the foot beyond the edge, a wrong cone, too deep)."""
-    gap, drift_n, drift_t, margin = vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht)
+    gap, drift_n, drift_t, margin = _vertex_on_edge_rows(row, point_body, edge_body, q, v, hn, ht, True)
     if not margin >= 0.0:
         return math.inf, 0.0, 0.0
     return gap, drift_n, drift_t
@@ -317,6 +317,14 @@ def vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht):
     one: the gap finite, the margin `_pair_margin` (the kernel's rule: counted iff margin ≥ 0;
     below 0 the drifts are left at 0).
     The event-driven reference locates where a contact enters or leaves its region from it."""
+    return _vertex_on_edge_rows(row, point_body, edge_body, q, v, hn, ht, False)
+
+
+@jitable
+def _vertex_on_edge_rows(row, point_body, edge_body, q, v, hn, ht, counted_only):
+    """vertex_on_edge_region; with `counted_only`, a pair outside its region (margin < 0) gets
+    zero rows, computed before its rows and drifts are: most vertex–edge candidates of two
+    touching boxes are not the touching pair, and the kernel reads nothing else of them."""
     ca, sa, px, py, rpx, rpy, vax, vay, om_a = _frame(point_body, q, v, row, C_OFF_AX, C_OFF_AY)
     if point_body < 0:
         px, py = row[C_LINE_PX], row[C_LINE_PY]
@@ -327,6 +335,11 @@ def vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht):
     dx, dy = px - ex, py - ey
     along = dx * tx + dy * ty
     gap = dx * nx + dy * ny - r
+    margin = _pair_margin(row, along, gap, dx, dy, tx, ty, nx, ny, cb, sb, ca, sa)
+    if counted_only and not margin >= 0.0:
+        _clear_side(hn, ht, 0)
+        _clear_side(hn, ht, 1)
+        return gap, 0.0, 0.0, margin
     rqx, rqy = rex + along * tx, rey + along * ty
     if point_body >= 0:
         _fill_rows(hn, ht, 0, nx, ny, rpx - r * nx, rpy - r * ny, 1.0)
@@ -337,7 +350,6 @@ def vertex_on_edge_region(row, point_body, edge_body, q, v, hn, ht):
     else:
         _fill_rows(hn, ht, 0, nx, ny, rqx, rqy, -1.0)
         _clear_side(hn, ht, 1)
-    margin = _pair_margin(row, along, gap, dx, dy, tx, ty, nx, ny, cb, sb, ca, sa)
     if not margin >= 0.0:
         return gap, 0.0, 0.0, margin  # not the touching pair: no drifts (the kernel's gap is infinite)
     # w: velocity of P's material point relative to E's; at fixed v the levers turn, so

@@ -134,18 +134,23 @@ def _interval_of(mu_s, mu_d, guess, lo, hi):
 
 
 # Statically indeterminate holds are searched on a dense W per group of coupled contacts; a
-# group larger than this (a pile of hundreds of disks) keeps the solver's split. pgs steps of at
-# most this many contacts that Gauss–Seidel cannot finish are solved again by Lemke.
+# group larger than this (a pile of hundreds of disks) keeps the solver's split.
 MAX_DENSE_HOLD = 64
+# pgs steps of at most this many active contacts that Gauss–Seidel cannot finish are solved
+# again by Lemke on the dense W (a rare step: its W of (2 × 256)² floats is 2 MB). With the
+# limit at MAX_DENSE_HOLD, the heap of 50 boxes (toys.BoxHeap, seed 1) stopped at t = 0.261 s
+# on a step of more active contacts that Gauss–Seidel could not finish.
+MAX_LEMKE_FALLBACK = 256
 
 
 @jit
 def pgs_scratch_sizes(n_contacts):
     """(floats, int64s) two_coefficient_into takes on a block-sparse W of up to n_contacts active
     contacts: the sign iteration's, then pgs's (the stall history, one int per contact) or its
-    fallback's (the dense W and Lemke's scratch, up to MAX_DENSE_HOLD contacts). What the loop's
-    per-run scratch holds for pgs (moreau_jean_loop.step_scratch), whatever the active set."""
-    m = min(n_contacts, MAX_DENSE_HOLD)
+    fallback's (the dense W and Lemke's scratch, up to MAX_LEMKE_FALLBACK contacts: np.empty, so
+    the pages of a fallback that never comes are never touched). What the loop's per-run scratch
+    holds for pgs (moreau_jean_loop.step_scratch), whatever the active set."""
+    m = min(n_contacts, MAX_LEMKE_FALLBACK)
     floats = SIGN_ITERATION_FLOATS * n_contacts + max(PGS_FLOATS, 4 * m * m + solver_floats(m))
     return floats, max(n_contacts, solver_ints(m))
 
@@ -161,14 +166,14 @@ def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallb
 @jit_borrowing
 def pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback, floats, ints):
     """pgs on the block-sparse W; with `fallback`, a step it cannot solve with at most
-    MAX_DENSE_HOLD contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
+    MAX_LEMKE_FALLBACK contacts is solved again by Lemke on the dense W. Gauss–Seidel can stall on a
     singular W (a pile: many coupled contacts, q a little outside W's range) just above its
     acceptance, where Lemke's pivoting is exact. Returns (status, sweeps + pivots, residual,
     1 if it fell back else 0). In the scratch (floats, ints: the solver's part of pgs_scratch_sizes
     — the dense W and Lemke's buffers of the fallback included); borrowing: it allocates nothing."""
     status, sweeps, residual = pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints)
     na = lo.shape[0]
-    if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_DENSE_HOLD:
+    if not fallback or status != KERNEL_NO_CONVERGENCE or na > MAX_LEMKE_FALLBACK:
         return status, sweeps, residual, 0
     if floats.shape[0] < 4 * na * na + solver_floats(na) or ints.shape[0] < solver_ints(na):
         return status, sweeps, residual, 0  # (a caller's scratch without room for it: pgs's answer stands)
