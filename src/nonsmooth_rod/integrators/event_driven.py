@@ -63,7 +63,7 @@ from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_i
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from ..solvers.registry import SolverName
 from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration, Refusal, first_item
-from .sampling import Thinning, grid_blocks, stop_event, stop_message, thinned_count
+from .sampling import OUTPUT_DT_KNOB, Thinning, grid_blocks, stop_event, stop_message, output_dt_samples
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
@@ -441,12 +441,8 @@ class EventDriven:
 
     name = "event-driven"
 
-    SAMPLES_KNOB = "a coarser output_dt or a shorter t_end"  # what keeps fewer samples (the driver's memory refusal says it)
-
-    @staticmethod
-    def samples_estimate(options, duration: float, save_every: float | None) -> float:
-        """How many samples a run keeps (every output_dt, or one per save_every, thinned as it runs)."""
-        return thinned_count(duration / options.output_dt, duration, save_every) + 2
+    SAMPLES_KNOB = OUTPUT_DT_KNOB
+    samples_estimate = staticmethod(output_dt_samples)
 
     def __init__(self, options: EventDrivenOptions | None = None):
         self.options = options or EventDrivenOptions()

@@ -53,7 +53,7 @@ from ..results import Event, Impact, SimulationResult, Trajectory, merge_short_p
 from ..validation import Choice, InputError, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration
 from .event_driven import ATOL_CEILING, RTOL_FLOOR
-from .sampling import Thinning, stop_event, stop_message, thinned_count
+from .sampling import OUTPUT_DT_KNOB, Thinning, stop_event, stop_message, output_dt_samples
 
 FRICTION_CURVES = ("stribeck", "tanh", "linear")
 ODE_METHODS = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA, "RK23": RK23}
@@ -209,12 +209,8 @@ class Regularized:
 
     name = "regularized"
 
-    SAMPLES_KNOB = "a coarser output_dt or a shorter t_end"  # what keeps fewer samples (the driver's memory refusal says it)
-
-    @staticmethod
-    def samples_estimate(options, duration: float, save_every: float | None) -> float:
-        """How many samples a run keeps (every output_dt, or one per save_every, thinned as it runs)."""
-        return thinned_count(duration / options.output_dt, duration, save_every) + 2
+    SAMPLES_KNOB = OUTPUT_DT_KNOB
+    samples_estimate = staticmethod(output_dt_samples)
 
     def __init__(self, options: RegularizedOptions | None = None):
         self.options = options or RegularizedOptions()

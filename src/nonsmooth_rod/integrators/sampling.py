@@ -30,6 +30,16 @@ def thinned_count(samples: float, duration: float, save_every: float | None) -> 
     return samples if save_every is None else min(samples, duration / save_every + 1.0)
 
 
+# What keeps fewer samples of a method that samples every output_dt (the driver's memory refusal says it).
+OUTPUT_DT_KNOB = "a coarser output_dt or a shorter t_end"
+
+
+def output_dt_samples(options, duration: float, save_every: float | None) -> float:
+    """How many samples a run that samples every `options.output_dt` keeps (or one per
+    save_every, thinned as it runs): the event-driven reference's and the regularized method's."""
+    return thinned_count(duration / options.output_dt, duration, save_every) + 2
+
+
 def stop_holds(stops, t, q, v) -> bool:
     """Whether any stop condition holds at (t, q, v) (each sees copies: none can change the run)."""
     return any(bool(cond(float(t), q.copy(), v.copy())) for cond in stops)
