@@ -88,3 +88,37 @@ def test_a_block_on_two_sticking_corners_is_left_to_mode_dynamics():
     assert ModeSystem(scene, modes, [("normal", 0, 0.0)]).evaluate(0.0, np.concatenate([q, v])) is None
     assert mode_dynamics(scene, 0.0, q, v, modes).singular
     assert ModeSystem(scene, ["stick", "open"]).evaluate(0.0, np.concatenate([q, v])) is not None
+
+
+RK4_A = np.array([[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+RK4_B = np.array([1 / 6, 1 / 3, 1 / 3, 1 / 6])
+
+
+@pytest.mark.parametrize("modes", [["stick", "open"], ["slip+", "open"], ["slip-", "stick"], ["open", "open"]])
+def test_a_runge_kutta_step_in_one_call_as_mode_dynamics_stage_by_stage(modes):
+    """ModeSystem.runge_kutta (the hybrid method's step): the classical RK4 step of the rod's mode
+    written out with mode_dynamics, every stage's state, the end state and what is watched there
+    to round-off; None where the mode solve would decline (a block on two sticking corners) or
+    the forces are not constant (a spring: the caller steps stage by stage)."""
+    problem = RodProblem.paper(2)
+    scene = problem.scene()
+    q0, v0 = problem.initial_state()
+    y, h, n = np.concatenate([q0 + 0.01, v0 + 0.3]), 0.05, scene.n_dof
+    system = ModeSystem(scene, modes, [("gap", 1, 0.0), ("normal", 0, 0.0)])
+    states, outs = system.runge_kutta(y, h, RK4_A, RK4_B)
+    expected, rates = [y], []
+    for i in range(4):
+        ys = expected[i]
+        rates.append(np.concatenate([ys[n:], mode_dynamics(scene, 0.0, ys[:n], ys[n:], modes).a]))
+        weights = RK4_B if i == 3 else RK4_A[i + 1]
+        expected.append(y + h * sum(w * f for w, f in zip(weights, rates)))
+    scale = float(np.max(np.abs(np.concatenate(rates))))
+    np.testing.assert_allclose(states, np.array(expected), rtol=0, atol=1e-13 * max(1.0, scale))
+    for state, out in zip(states, outs):
+        evaluated = system.evaluate(0.0, state)
+        np.testing.assert_array_equal(out, evaluated)  # the same compiled solve at the same state
+    law = ContactLaw.of(mu_s=0.5, mu_d=0.4)
+    corners = [DiskOnLine(0, (x, -0.3), Line(), law=law, name=name) for x, name in ((-0.2, "left"), (0.2, "right"))]
+    block = Scene([RigidBody(mass=2.0, inertia=0.1)], corners)
+    assert ModeSystem(block, ["stick", "stick"]).runge_kutta(np.r_[0.0, 0.3, 0.0, np.zeros(3)], h, RK4_A, RK4_B) is None
+    assert ModeSystem(_two_bodies(), ["open", "open"]).runge_kutta(np.zeros(12), h, RK4_A, RK4_B) is None

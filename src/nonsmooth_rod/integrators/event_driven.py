@@ -432,6 +432,13 @@ class _Run:
         return self.samples + ([self.unkept] if self.unkept is not None else [])
 
 
+def _smallest_eigenvalue_real(A) -> float:
+    """The smallest real part of A's eigenvalues; for a 1 × 1 A (one sliding contact) its entry,
+    without LAPACK's call (whose value can differ in the last bit at tiny magnitudes, never in
+    the sign the caller tests)."""
+    return float(A[0, 0]) if A.shape == (1, 1) else float(np.min(np.linalg.eigvals(A).real))
+
+
 def _force_scale(scene, t, q, v) -> float:
     return max(1e-12, float(np.max(np.abs(scene.force(t, q, v)))))
 
@@ -487,7 +494,7 @@ class EventDriven:
                 acc_T = k.H_T @ dyn.a + k.drift_T
                 if SLIP_SIGN[mode] * acc_T < -1e-9 * ascale:
                     return None
-            if mode != "stick" and dyn.matrix.size and np.min(np.linalg.eigvals(dyn.matrix).real) <= 0:
+            if mode != "stick" and dyn.matrix.size and _smallest_eigenvalue_real(dyn.matrix) <= 0:
                 return None
         return dyn
 

@@ -44,6 +44,10 @@ TABLEAUX = {
     3: ((0.0, 0.5, 1.0), ((), (0.5,), (-1.0, 2.0)), (1 / 6, 2 / 3, 1 / 6), 1),
     4: ((0.0, 0.5, 0.5, 1.0), ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0)), (1 / 6, 1 / 3, 1 / 3, 1 / 6), 2),
 }
+# The tableaux's a (lower triangular, square) and b as arrays, for the compiled step.
+TABLEAU_ARRAYS = {order: (np.array([[row[j] if j < len(row) else 0.0 for j in range(len(c))] for row in a]),
+                          np.array(b, dtype=float))
+                  for order, (c, a, b, _) in TABLEAUX.items()}
 # A dip of an indicator between a step's samples is looked at closely when the parabola through
 # them has an interior minimum below this fraction of the smaller end value.
 DIP_FRACTION = 0.5
@@ -111,9 +115,12 @@ class _Mode:
 class _Stage:
     """The mode's dynamics at one state: its derivative, what the indicators read there."""
 
-    def __init__(self, mode: _Mode, t, y):
+    def __init__(self, mode: _Mode, t, y, out=None):
         self.t, self.y, self.mode = t, y, mode
-        self.f, self.values, self._solved = mode.evaluate(t, y)
+        if out is None:
+            self.f, self.values, self._solved = mode.evaluate(t, y)
+        else:  # the compiled mode solve's evaluation at (t, y), made already (ModeSystem.runge_kutta)
+            self.f, self.values, self._solved = out[mode.system.rates], out[mode.system.values], out
 
     def dynamics(self) -> ModeDynamics:
         return self.mode.dynamics(self._solved)
@@ -187,6 +194,15 @@ class _StepWatch(_Watch):
             self._start_band(j, nodes_t, nodes_s)
 
 
+def _combine(y, h, weights, stages) -> np.ndarray:
+    """y + h Σ w_j f_j over the stages with a nonzero weight (a tableau's row), summed in order."""
+    total = None
+    for w, stage in zip(weights, stages):
+        if w:
+            total = w * stage.f if total is None else total + w * stage.f
+    return y + h * total
+
+
 def _parabola_minimum(ts, s):
     """(t, value) of the interior minimum of the parabola through three samples, or None."""
     (t0, t1, t2), (s0, s1, s2) = ts, s
@@ -231,8 +247,9 @@ class Hybrid(EventDriven):
 
     def _system(self, scene, modes, watched=()) -> ModeSystem:
         key = (tuple(modes), watched)
-        if key not in self._systems:
-            self._systems[key] = ModeSystem(scene, modes, watched)
+        if key not in self._systems:  # the scene's packed contacts shared by its systems in this run
+            like = next(iter(self._systems.values()), None)
+            self._systems[key] = ModeSystem(scene, modes, watched, like)
         return self._systems[key]
 
     def _dynamics(self, scene, t, q, v, modes, kin=None):
@@ -279,13 +296,16 @@ class Hybrid(EventDriven):
     def _step(self, mode: _Mode, start: _Stage, h: float, run):
         """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""
         c, a, b, mid = TABLEAUX[self.options.order]
+        run.nfev += len(c)
+        stepped = mode.system.runge_kutta(start.y, h, *TABLEAU_ARRAYS[self.options.order]) if mode.system else None
+        if stepped is not None:  # the whole step in one compiled call: the same sums, the same solves
+            states, outs = stepped
+            return (_Stage(mode, start.t + c[mid] * h, states[mid], outs[mid]),
+                    _Stage(mode, start.t + h, states[-1], outs[-1]))
         stages = [start]
         for i in range(1, len(c)):
-            y = start.y + h * sum(a_ij * stages[j].f for j, a_ij in enumerate(a[i]) if a_ij)
-            stages.append(_Stage(mode, start.t + c[i] * h, y))
-        y_end = start.y + h * sum(b_i * st.f for b_i, st in zip(b, stages) if b_i)
-        end = _Stage(mode, start.t + h, y_end)
-        run.nfev += len(c)
+            stages.append(_Stage(mode, start.t + c[i] * h, _combine(start.y, h, a[i], stages)))
+        end = _Stage(mode, start.t + h, _combine(start.y, h, b, stages))
         return stages[mid], end
 
 

@@ -157,16 +157,20 @@ class ModeSystem:
     falls back on mode_dynamics. `watched`: (what, contact, offset) triples, `what` a key of
     WATCH_CODES; each value is the quantity minus the offset."""
 
-    def __init__(self, scene: Scene, modes, watched=()):
+    def __init__(self, scene: Scene, modes, watched=(), like: ModeSystem | None = None):
         n, nc = scene.n_dof, len(scene.contacts)
         self.scene, self.n_dof = scene, n
-        packed = [c._packed_row() for c in scene.contacts]
-        self.usable = all(kind == KIND_DISK_ON_LINE and c.obstacle_motion is None
-                          for (kind, _, _, _), c in zip(packed, scene.contacts))
-        self.table = np.array([row for _, _, _, row in packed], dtype=float).reshape(nc, N_CONTACT_COLUMNS)
-        self.table[:, C_MU_S] = [c.law.friction.mu_s for c in scene.contacts]
-        self.table[:, C_MU_D] = [c.law.friction.mu_d for c in scene.contacts]
-        self.ints = np.array([(body, MODE_CODES[mode]) for (_, body, _, _), mode in zip(packed, modes)],
+        if like is None:  # the scene's packed contacts; `like`: another mode's system of this scene has them
+            packed = [c._packed_row() for c in scene.contacts]
+            self.usable = all(kind == KIND_DISK_ON_LINE and c.obstacle_motion is None
+                              for (kind, _, _, _), c in zip(packed, scene.contacts))
+            self.table = np.array([row for _, _, _, row in packed], dtype=float).reshape(nc, N_CONTACT_COLUMNS)
+            self.table[:, C_MU_S] = [c.law.friction.mu_s for c in scene.contacts]
+            self.table[:, C_MU_D] = [c.law.friction.mu_d for c in scene.contacts]
+            self.bodies = [body for _, body, _, _ in packed]
+        else:
+            self.usable, self.table, self.bodies = like.usable, like.table, like.bodies
+        self.ints = np.array([(body, MODE_CODES[mode]) for body, mode in zip(self.bodies, modes)],
                              dtype=np.int64).reshape(nc, 2)
         self.watched = np.array([(WATCH_CODES[what], i) for what, i, _ in watched], dtype=np.int64).reshape(-1, 2)
         self.offsets = np.array([offset for _, _, offset in watched], dtype=float)
@@ -192,6 +196,21 @@ class ModeSystem:
         if not mode_rates_into(self.table, self.ints, self.watched, self.offsets, self.minv, free, y, self.out):
             return None
         return self.out.copy()
+
+    def runge_kutta(self, y: np.ndarray, h: float, a: np.ndarray, b: np.ndarray):
+        """One explicit Runge–Kutta step of h from y (the tableau's a, lower triangular, and b) in
+        one compiled call: (the stages' states and the end state, rows of an (s + 1) × 2n array;
+        their evaluations in the layout above, rows alike), or None where `evaluate` would decline
+        or the forces are not constant (the caller steps stage by stage). The stages' sums are
+        those of y + h Σ a_ij f_j over the nonzero weights, in order, as the caller's."""
+        if not (self.usable and self.constant):
+            return None
+        s = b.shape[0]
+        states, outs = np.empty((s + 1, y.shape[0])), np.empty((s + 1, self.out.shape[0]))
+        if not runge_kutta_into(self.table, self.ints, self.watched, self.offsets, self.minv, self.free, y, h, a, b,
+                                states, outs):
+            return None
+        return states, outs
 
     def dynamics(self, out: np.ndarray) -> ModeDynamics:
         """The ModeDynamics of an evaluation."""
@@ -239,6 +258,26 @@ def mode_rates_into(table, ints, watched, offsets, minv, free, y, out) -> bool:
     for d in range(n):
         out[d] = v[d]
     _watched_values(watched, offsets, table, gaps, slips, out, 2 * n, nc)
+    return True
+
+
+@jit
+def runge_kutta_into(table, ints, watched, offsets, minv, free, y, h, a, b, states, outs) -> bool:
+    """ModeSystem.runge_kutta: states[i] the stage i's state (states[s] the end), outs[i] its
+    mode_rates_into; False where a mode solve declines."""
+    s, dim = b.shape[0], y.shape[0]
+    for i in range(s + 1):
+        weights = b if i == s else a[i]
+        for d in range(dim):
+            total, started = 0.0, False
+            for j in range(min(i, s)):
+                if weights[j] != 0.0:
+                    term = weights[j] * outs[j, d]
+                    total = term if not started else total + term
+                    started = True
+            states[i, d] = y[d] + h * total if started else y[d]
+        if not mode_rates_into(table, ints, watched, offsets, minv, free, states[i], outs[i]):
+            return False
     return True
 
 
