@@ -19,8 +19,9 @@ minimisation then brentq). Events are located to the interpolant's accuracy, O(h
 
 Every mode solve — the stages, the watch's values, the reference's mode decisions, rest test and
 samples (`_dynamics`) — runs through model/dynamics.ModeSystem, mode_dynamics' equations set up
-once per mode and compiled with the indicators' values; mode_dynamics itself where it declines
-(a statically indeterminate A).
+once per mode and compiled with the indicators' values, a whole step's stages and end in one
+compiled call (`ModeSystem.runge_kutta`) where the forces are constant; mode_dynamics itself
+where it declines (a statically indeterminate A).
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.dynamics import ModeDynamics, ModeSystem, mode_dynamics
+from ..model.dynamics import ModeDynamics, ModeSystem, hermite_into, mode_dynamics
 from ..solvers import available_solvers
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
@@ -132,9 +133,10 @@ def _hermite(a: _Stage, b: _Stage):
 
     def dense(t: float) -> np.ndarray:
         s = (t - a.t) / h
-        h00, h10 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2
-        h01, h11 = s * s * (3 - 2 * s), s * s * (s - 1)
-        return h00 * a.y + h01 * b.y + h * (h10 * a.f + h11 * b.f)
+        out = np.empty_like(a.y)
+        hermite_into(((1 + 2 * s) * (1 - s) ** 2, s * s * (3 - 2 * s), s * (1 - s) ** 2, s * s * (s - 1)), h, a.y, b.y,
+                     a.f, b.f, out)
+        return out
     return dense
 
 

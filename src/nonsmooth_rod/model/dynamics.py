@@ -282,6 +282,17 @@ def runge_kutta_into(table, ints, watched, offsets, minv, free, y, h, a, b, stat
 
 
 @jit
+def hermite_into(weights, h, y0, y1, f0, f1, out):
+    """A cubic Hermite interpolant of a step of h from both ends' states y and rates f into out:
+    with weights (h00, h01, h10, h11), numpy's h00 y0 + h01 y1 + h (h10 f0 + h11 f1) element by
+    element — the same numbers without seven small arrays (the weights come from the caller:
+    numba's power of a float can differ from Python's in the last bit)."""
+    h00, h01, h10, h11 = weights
+    for d in range(out.shape[0]):
+        out[d] = h00 * y0[d] + h01 * y1[d] + h * (h10 * f0[d] + h11 * f1[d])
+
+
+@jit
 def _watched_values(watched, offsets, table, gaps, slips, out, at, nc):
     """The watched values (WATCH_CODES) into out[at:], from the gaps, slips and out's N, T, det."""
     k = watched.shape[0]
