@@ -26,3 +26,23 @@ def test_a_dropped_heap_of_boxes_rests_without_any_box_through_another():
     fastest = math.sqrt(2 * 9.81 * q0[1::3].max())
     assert deepest_overlap(scene.bodies, heap.shapes(), result.trajectory.q, lines) < H * fastest
     assert np.abs(result.trajectory.v[-1]).max() < 1e-6  # at rest
+
+
+def test_the_fifty_box_heap_runs_with_pgs_where_gauss_seidel_needs_lemke_on_more_than_64_contacts():
+    """Seed 1: at t ≈ 0.26 s a step has more active contacts than 64 that Gauss–Seidel cannot
+    finish; Lemke on the dense W solves it from the run's scratch (sized for MAX_LEMKE_FALLBACK
+    contacts). With a fallback limited to 64 — or a scratch without room for it — the run failed
+    there. Compiled only (~5 s)."""
+    import pytest
+    from nonsmooth_rod import _jit
+
+    if not _jit.ENABLED:
+        pytest.skip("numba not installed or disabled: interpreted, this run takes minutes")
+    heap = BoxHeap(50, seed=1)
+    scene, (q0, v0) = heap.scene(), heap.initial_state()
+    result = nr.simulate(scene, q0, v0, 0.3, "moreau-jean", h=H, solver="pgs", save_every=0.01)
+    assert result.status == "ok", result.message[:300]
+    assert result.stats["solver_fallbacks"] > 0  # the steps Gauss–Seidel could not finish
+    fastest = math.sqrt(2 * 9.81 * q0[1::3].max())
+    lines = list(heap.obstacles().values())
+    assert deepest_overlap(scene.bodies, heap.shapes(), result.trajectory.q, lines) < H * fastest
