@@ -30,9 +30,9 @@ def test_a_dropped_heap_of_boxes_rests_without_any_box_through_another():
 
 def test_the_fifty_box_heap_runs_with_pgs_where_gauss_seidel_needs_lemke_on_more_than_64_contacts():
     """Seed 1: at t ≈ 0.26 s a step has more active contacts than 64 that Gauss–Seidel cannot
-    finish; Lemke on the dense W solves it from the run's scratch (sized for MAX_LEMKE_FALLBACK
-    contacts). With a fallback limited to 64 — or a scratch without room for it — the run failed
-    there. Compiled only (~5 s)."""
+    finish; Lemke on the dense W solves it (up to MAX_LEMKE_FALLBACK contacts). With the fallback
+    limited to 64 the run fails there (checked: this test fails with MAX_LEMKE_FALLBACK = 64).
+    Compiled only (~5 s)."""
     import pytest
     from nonsmooth_rod import _jit
 
