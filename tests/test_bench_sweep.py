@@ -1,17 +1,15 @@
 """benchmarks/bench_sweep.py --quick runs and reports sane numbers (no speed is asserted here)."""
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
+from scripts import load_script
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_sweep.py"
 
 
 def test_bench_sweep_quick(capsys):
-    spec = importlib.util.spec_from_file_location("bench_sweep", BENCH)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
+    bench = load_script(BENCH)
     report = bench.main(["--quick", "--skip-map"])
     assert report["yardstick_us"] > 0
     # The event-driven reference is far dearer per point than the compiled Moreau–Jean path.

@@ -2,17 +2,15 @@
 three-coordinate models' (the numbers themselves are tested in tests/toys/test_woodpecker.py)."""
 from __future__ import annotations
 
-import importlib.util
 import re
 from pathlib import Path
+from scripts import load_script
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_woodpecker.py"
 
 
 def test_bench_woodpecker_quick(capsys):
-    spec = importlib.util.spec_from_file_location("bench_woodpecker", BENCH)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
+    bench = load_script(BENCH)
     assert bench.main(["--quick"]) == 0
     out = capsys.readouterr().out
     periods = [float(p) for p in re.findall(r"period ([0-9.]+) s", out)]

@@ -4,18 +4,15 @@ or a plausible run (finite, ok or a failure said in one line, ending at t_end) â
 traceback, a hang or a wrong ok. The larger battery: python benchmarks/fuzz_inputs.py."""
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
+from scripts import load_script
 
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "fuzz_inputs.py"
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("fuzz_inputs", BENCH)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(BENCH)
 
 
 def test_mutants_of_the_examples_are_refused_cleanly_or_run_plausibly():

@@ -2,18 +2,15 @@
 sliding off a table's end (found contacts) within a few steps of the event-driven reference's
 located events, and the reference's sliding-phase events at their closed forms."""
 import csv
-import importlib.util
 import math
 from pathlib import Path
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_box_off_table", ROOT / "benchmarks" / "bench_box_off_table.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_box_off_table.py")
 
 
 def test_quick_run_puts_moreau_jeans_boundaries_within_a_few_steps_of_the_located_events(tmp_path, capsys):

@@ -1,22 +1,19 @@
 """Moreau–Jean's discrete energy balance (docs/friction.md, "Energy"), checked on random scenes by
 benchmarks/bench_energy.py: its quick mode, the θ-method's own term, and the order in h of what
 the start-of-step Jacobian adds."""
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import nonsmooth_rod as nr
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_energy", ROOT / "benchmarks" / "bench_energy.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_energy.py")
 
 
 def _scene(index, seed=28):

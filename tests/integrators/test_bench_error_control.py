@@ -2,17 +2,14 @@
 tolerance against the event-driven reference, the hybrid method at h = 5e-2 locates the impact
 within 1e-5 s, and its table, CSV and chart are written."""
 import csv
-import importlib.util
 from pathlib import Path
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_error_control", ROOT / "benchmarks" / "bench_error_control.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_error_control.py")
 
 
 def test_quick_run_meets_the_tolerances_and_writes_its_files(tmp_path, capsys):

@@ -3,19 +3,16 @@ grazing peak (issue 28) and the part of it that is the error of the state itself
 docs/error_control.md ("Stick decisions at fixed steps") says a decision on the end-of-step
 state cannot remove."""
 import csv
-import importlib.util
 from pathlib import Path
 
 import pytest
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_grazing", ROOT / "benchmarks" / "bench_grazing.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_grazing.py")
 
 
 def test_quick_run_measures_a_first_order_overshoot_of_which_the_state_is_a_part(tmp_path, capsys):

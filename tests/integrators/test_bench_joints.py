@@ -1,16 +1,13 @@
 """benchmarks/bench_joints.py --quick: a double pendulum's joints stay at round-off (the full run,
 10⁶ steps, is the issue's check: docs/joints.md)."""
-import importlib.util
 from pathlib import Path
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_joints", ROOT / "benchmarks" / "bench_joints.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_joints.py")
 
 
 def test_quick_run_keeps_the_joints_at_round_off(capsys):

@@ -1,19 +1,16 @@
 """benchmarks/bench_memory.py --quick: the peak memory of a run follows what it keeps, near the
 driver's estimate, and a stop at 5 % of t_end costs a small part of the whole run."""
-import importlib.util
 import sys
 from pathlib import Path
 
 import pytest
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench_memory():
-    spec = importlib.util.spec_from_file_location("bench_memory", ROOT / "benchmarks" / "bench_memory.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_memory.py")
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")

@@ -3,20 +3,17 @@
 the last impact at the reference's time, the ratio within 1e-4 of Housner's at every impact
 while |θ̇| ≥ 0.05 rad/s, and fewer impacts counted (the Zeno tail below the velocity resolution)."""
 import csv
-import importlib.util
 import math
 from pathlib import Path
 
 import nonsmooth_rod as nr
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_rocking", ROOT / "benchmarks" / "bench_rocking.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_rocking.py")
 
 
 def test_quick_run_writes_its_table(tmp_path, capsys):

@@ -4,17 +4,14 @@ Run in this process, not a subprocess: it shares the kernels this test process h
 loaded from the cache) instead of compiling the engine again, and measures neither the cold
 compile (--no-compile-time) nor MuJoCo (the ladder is not a ball row).
 """
-import importlib.util
 from pathlib import Path
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _benchmark(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / f"{name}.py")
 
 
 def _bench_scenes():

@@ -1,18 +1,16 @@
 """benchmarks/bench_startup.py --quick runs (timings are not asserted), and a Moreau–Jean run of
 a scene leaves the heavy imports alone (issue 16)."""
-import importlib.util
 import os
 import subprocess
 import sys
 from pathlib import Path
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_bench_startup_quick_runs(capsys):
-    spec = importlib.util.spec_from_file_location("bench_startup", ROOT / "benchmarks" / "bench_startup.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script(ROOT / "benchmarks" / "bench_startup.py")
     assert module.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert [line.split()[1] for line in out.splitlines() if line.startswith("import ")] == list(module.ENTRY_POINTS)

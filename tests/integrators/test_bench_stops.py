@@ -1,18 +1,15 @@
 """benchmarks/bench_stops.py --quick: for every method, a stop holding at 5 % of t_end costs a
 small part of the whole run (issue 22: at most 10 %; the benchmark exits 1 beyond), and ends
 at the first sample past the dropped ball's closed-form fall time."""
-import importlib.util
 from pathlib import Path
+from scripts import load_script
 
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench_stops():
-    spec = importlib.util.spec_from_file_location("bench_stops", ROOT / "benchmarks" / "bench_stops.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_stops.py")
 
 
 def test_a_stop_at_five_percent_costs_a_small_part_of_the_run_for_every_method():

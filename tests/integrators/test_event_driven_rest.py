@@ -1,5 +1,4 @@
 """Event-driven reference: a body at rest costs (almost) nothing, and the rest is exact."""
-import importlib.util
 import math
 from pathlib import Path
 
@@ -14,6 +13,7 @@ from nonsmooth_rod.model.contacts import DiskOnLine, Line, PointOnLine
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.validation import InputError
+from scripts import load_script
 
 G, MASS, WIDTH, HEIGHT, MU_S, MU_D = 9.81, 2.0, 0.2, 0.1, 0.5, 0.4
 BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_event_driven_rest.py"
@@ -84,9 +84,7 @@ def test_an_output_grid_too_fine_to_hold_is_refused_up_front():
 
 
 def test_the_resting_benchmark_runs_in_quick_mode(capsys):
-    spec = importlib.util.spec_from_file_location("bench_event_driven_rest", BENCH)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
+    bench = load_script(BENCH)
     assert bench.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert "at rest" in out and "applied force" in out and "ED/MJ" in out

@@ -9,6 +9,7 @@ from nonsmooth_rod import _jit
 from nonsmooth_rod.integrators.moreau_jean import MoreauJean, MoreauJeanOptions
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.toys import BlockOnIncline, DiskPyramid, Ladder, WedgedRod
+from scripts import load_script
 
 SOLVERS = ["lemke", "pgs", "enum"]
 HOLD_TOL = 1e-10  # |Δq| of a configuration that must stay at rest
@@ -160,13 +161,10 @@ def test_a_held_body_and_a_sliding_body_in_one_step(solver):
 
 
 def test_quick_drift_benchmark_runs_and_every_toy_holds(capsys):
-    import importlib.util
     from pathlib import Path
 
     path = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_static_indeterminacy.py"
-    spec = importlib.util.spec_from_file_location("bench_static_indeterminacy", path)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
+    bench = load_script(path)
     assert bench.main(["--quick"]) == 0
     assert capsys.readouterr().out.count("True") == 16  # 4 toys x 4 solver runs, all stuck
 

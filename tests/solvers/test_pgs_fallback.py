@@ -8,7 +8,6 @@ pgs alone (its failure is reported: tests/integrators/test_solver_failure_report
 """
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +20,7 @@ from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity
 from nonsmooth_rod.solvers.two_coefficient import MAX_DENSE_HOLD, MAX_LEMKE_FALLBACK, pgs_or_lemke
 from nonsmooth_rod.toys.stacks import disk_pile
 from solver_cases import block_on_incline
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -109,7 +109,4 @@ def test_the_pile_obeys_the_law_and_gains_no_more_energy_than_the_start_work(pil
 
 
 def _bench_energy():
-    spec = importlib.util.spec_from_file_location("bench_energy", ROOT / "benchmarks" / "bench_energy.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(ROOT / "benchmarks" / "bench_energy.py")

@@ -3,7 +3,6 @@
 trajectory. Synthetic measurements come from the event-driven reference at the true values."""
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 
@@ -15,6 +14,7 @@ from nonsmooth_rod.scenefile import parse_scene, simulate_scene
 from nonsmooth_rod.studies.fitting import fit
 from nonsmooth_rod.studies.maps import scene_data
 from nonsmooth_rod.studies.measurements import Measurements
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "examples" / "scenes"
@@ -23,10 +23,7 @@ REFERENCE = ["simulation.event-driven.rtol=1e-9", "simulation.event-driven.atol=
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_studies", ROOT / "benchmarks" / "bench_studies.py")
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
-    return bench
+    return load_script(ROOT / "benchmarks" / "bench_studies.py")
 
 
 def test_the_rods_friction_is_recovered_at_the_rate_statistics_predicts():

@@ -3,7 +3,6 @@ restitution, whose second impact time t2 = t1 (1 + 2e) is linear in e, the poste
 closed-form Gaussian (mean (t2/t1 − 1)/2, sd σ/(2 t1)); bad chain settings are refused."""
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
@@ -11,15 +10,13 @@ import pytest
 from nonsmooth_rod.studies.fitting import fit
 from nonsmooth_rod.studies.measurements import Measurements
 from nonsmooth_rod.validation import InputError
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_studies", ROOT / "benchmarks" / "bench_studies.py")
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
-    return bench
+    return load_script(ROOT / "benchmarks" / "bench_studies.py")
 
 
 def test_the_posterior_of_the_balls_restitution_is_the_closed_form_gaussian():

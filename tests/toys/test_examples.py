@@ -1,20 +1,17 @@
 """Every toy example runs as `python examples/NAME.py --out DIR` would and writes its figure;
 the numbers it prints agree with the closed forms it quotes."""
-import importlib.util
 import re
 from pathlib import Path
 
 import pytest
+from scripts import load_script
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 NAMES = sorted(p.stem for p in EXAMPLES.glob("*.py"))
 
 
 def _load(name):
-    spec = importlib.util.spec_from_file_location(f"toy_example_{name}", EXAMPLES / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(EXAMPLES / f"{name}.py")
 
 
 def test_every_toy_has_an_example():

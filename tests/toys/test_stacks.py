@@ -9,7 +9,6 @@ gravity and the approach speed move a disk in one step beyond the activation's p
 ≲ h (v + g h): at h = 1 ms, v ≤ 1.5 m/s in a 0.1 m fall, 1.5e-3 m (measured: ≪ that)."""
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +17,7 @@ import pytest
 import nonsmooth_rod as nr
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.toys import stacks
+from scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 H = 1e-3
@@ -82,9 +82,7 @@ def test_pgs_takes_lemkes_contact_states(make):
 
 
 def test_bench_piles_quick_runs(capsys):
-    spec = importlib.util.spec_from_file_location("bench_piles", ROOT / "benchmarks" / "bench_piles.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script(ROOT / "benchmarks" / "bench_piles.py")
     assert module.main(["--quick"]) == 0
     out = capsys.readouterr().out
     lines = [line for line in out.splitlines() if line.startswith(("ball row", "pile 4"))]
