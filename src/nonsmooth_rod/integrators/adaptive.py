@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import accumulation
 from . import moreau_jean_loop as loop
 from .sampling import save_slots, stop_event, stop_holds, stop_message
 from .moreau_jean_records import HISTORY, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, ResumeState
@@ -46,6 +47,10 @@ GRADING = 2.0
 # not once per step, keeps the bias of removing the velocity's lag small (docs/error_control.md:
 # measured on the rod, 8 steps leave an x_O error of 2.7e-6 m whatever tol, 32 meet tol = 1e-6).
 WINDOW_STEPS = 32
+# A window with an impact is accepted only at steps this many times shorter than another event's:
+# the velocities after an impact are as good as the steps beside it (its velocity ratio — Housner's
+# on the rocking block — within 1e-4 down to flights of tol, docs/error_control.md "Rocking").
+IMPACT_REFINEMENT = 4
 MEMORY = (WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN)
 
 
@@ -64,7 +69,8 @@ class Point:
     forced: bool = False  # accepted at the smallest step above tol
     err: float = 0.0  # the window's position error estimate, ‖q_fine − q_coarse‖∞
     err_v: float = 0.0  # its velocity error estimate, ‖v_fine − v_coarse‖∞ (carried into positions later)
-    impacts: list = field(default_factory=list)  # (contact, t_hit, t_row, q_row, v_row, v_after, p_n, p_t)
+    # (contact, t_hit, t_row, q_row, v_row, v_after, p_n, p_t, v before and after at t_hit or None: _at_impact)
+    impacts: list = field(default_factory=list)
     impulses: tuple = ()  # (p_normal, p_tangent) of the step's two halves together
     states: np.ndarray | None = None  # the state codes of its last half step
     switches: dict = field(default_factory=dict)  # contact → start of its first fine step in a new state
@@ -141,10 +147,12 @@ class Stepper:
         m = 2 * n
         status, out = self.run(point, H / m, m)
         impacts = []
-        for j in range(int(out[9][loop.K_N_IMPACTS])):
-            row = int(out[7][j])
-            impacts.append((int(out[8][j]), float(out[6][j]), point.t + (row - 1) * H / m, out[0][row].copy(),
-                            out[1][row].copy(), out[1][row + 1].copy(), out[2][row].copy(), out[3][row].copy()))
+        rows = [int(out[7][j]) for j in range(int(out[9][loop.K_N_IMPACTS]))]
+        for j, row in enumerate(rows):
+            t_row, t_hit = point.t + (row - 1) * H / m, float(out[6][j])
+            impacts.append((int(out[8][j]), t_hit, t_row, out[0][row].copy(), out[1][row].copy(),
+                            out[1][row + 1].copy(), out[2][row].copy(), out[3][row].copy(),
+                            *_at_impact(out[1], row, m, set(rows), (t_hit - t_row) / (H / m))))
         states = np.vstack([states_c, out[5][1: m + 1]])
         records = tuple(out[2 + j][m].copy() for j in range(4))
         impulses = (out[2][1: m + 1].sum(axis=0), out[3][1: m + 1].sum(axis=0))
@@ -164,6 +172,7 @@ class Controller:
         self.tol, self.max_step, self.t_end, self.extrapolate = tol, max_step, t_end, extrapolate
         self.window_steps = WINDOW_STEPS
         self.h_event = tol * WINDOW_STEPS  # an event's window: its steps, and the switch located in them, within tol
+        self.h_impact = self.h_event / IMPACT_REFINEMENT
         self.h_min = tol * MIN_STEP_FRACTION
         self.points = [first]
         self.H = min(max_step, t_end - first.t)
@@ -186,13 +195,15 @@ class Controller:
         """Accept or reject the attempt of H; True when a Point was added."""
         point = self.points[-1]
         err = float(np.max(np.abs(att.q_fine - att.q_coarse)))
-        event = bool(att.impacts) or att.n_impacts_coarse > 0 or not np.all(att.states == point.records[3])
+        impact = bool(att.impacts) or att.n_impacts_coarse > 0
+        event = impact or not np.all(att.states == point.records[3])
+        h_event = self.h_impact if impact else self.h_event
         at_floor = H <= self.h_min * (1 + 1e-9)  # accepted whatever its estimate (counted as forced)
-        if event and H > self.h_event and not at_floor:
+        if event and H > h_event and not at_floor:
             return self._retry(H, 0.5)
         if err > self.tol and not at_floor:
             return self._retry(H, max(SHRINK_MIN, SAFETY * math.sqrt(self.tol / err)))
-        if event and point.h > self.h_event and len(self.points) > 1 and not point.event:
+        if event and point.h > h_event and len(self.points) > 1 and not point.event:
             return self._take_back(point, H)
         smooth = not event
         q, v = self.extrapolate(att, point.records) if smooth else (att.q_fine, att.v_fine)  # Richardson
@@ -221,6 +232,22 @@ class Controller:
         self.cap_until = max(self.cap_until, point.t + H)
         self.H = self.cap
         return False
+
+
+def _at_impact(v, row: int, m: int, impact_rows: set, s: float) -> tuple:
+    """The velocities just before and after an impact inside step `row` (at the fraction s of it),
+    each carried to the impact instant at the rate of the smooth step beside it (rows of v:
+    1 … m + 1), or None where that step is not in the window or has an impact of its own.
+
+    A step's end velocity is that of the step's end, h (1 − s) after the impact: with the rocking
+    block's pivot changing at it, its angular acceleration moves θ̇ by ~25 rad/s² · h there, which
+    at tol = 1e-6 (h = 5e-7 s) is 1e-4 of |θ̇| = 1e-1 rad/s (docs/error_control.md, "Rocking")."""
+    before = after = None
+    if row - 1 >= 1 and row - 1 not in impact_rows:
+        before = v[row] + s * (v[row] - v[row - 1])
+    if row + 2 <= m + 1 and row + 1 not in impact_rows:
+        after = v[row + 1] - (1.0 - s) * (v[row + 2] - v[row + 1])
+    return before, after
 
 
 def _loaded(scene, before: tuple, after: tuple, impacts: list) -> list:
@@ -359,18 +386,22 @@ def _samples(points: list, nc: int, save_every: float | None):
     return t[keep], q[keep], v[keep], a[keep], N[keep], T[keep], codes[keep]
 
 
-def _impacts(scene, points: list, names: list, position_error: np.ndarray):
+def _impacts(scene, points: list, names: list, position_error: np.ndarray, resolution: float):
     """Impact records and events, each with its time error estimate: the step it lies in plus the
-    position error estimate reached there over the closing speed."""
+    position error estimate reached there over the closing speed; those `resolution` calls an
+    accumulation's unresolved tail left out (integrators/accumulation.py)."""
     minv = scene.inverse_mass_diagonal
     impacts, events = [], []
     for k, point in enumerate(points):
-        for i, t_hit, t_row, q_row, v_row, v_after, p_n, p_t in point.impacts:
-            f = scene.force(t_row, q_row, v_row)
-            v_hit = v_row + (t_hit - t_row) * minv * f
+        for i, t_hit, t_row, q_row, v_row, v_after, p_n, p_t, v_hit, v_after_hit in point.impacts:
+            if v_hit is None:  # no smooth step before it in the window: the applied force's rate
+                v_hit = v_row + (t_hit - t_row) * minv * scene.force(t_row, q_row, v_row)
+            v_after = v_after if v_after_hit is None else v_after_hit
             q_hit = q_row + (t_hit - t_row) * v_row
             kin = scene.contacts[i].kinematics(q_hit, v_hit, scene.n_dof)
             speed = max(abs(float(kin.H_N @ v_hit)), 1e-300)
+            if not accumulation.impact_resolved(scene, i, t_hit, q_hit, v_hit, resolution):
+                continue
             error = point.h + points[k - 1].h + position_error[k] / speed
             impacts.append(Impact(t_hit, names[i], q_hit, v_hit, v_after, p_n, p_t))
             events.append(Event(t_hit, "impact", names[i], {"error": float(error)}))
@@ -424,7 +455,7 @@ def _result(integrator, scene, ctrl: Controller, stepper: Stepper, ending, names
     t, q, v, a, N, T, codes = _samples(points, len(names), save_every)
     modes = np.array(STATE_NAMES, dtype=object)[codes]
     position_error = position_error_estimate(points)
-    impacts, events = _impacts(scene, points, names, position_error)
+    impacts, events = _impacts(scene, points, names, position_error, opts.resolution)
     t_stop = max((imp.t for imp in impacts if imp.contact == opts.stop_at_impact), default=None) \
         if message.startswith("stopped at the impact") else None
     phases, phase_events = ({}, []) if len(points) < 2 else _phases(points, names, impacts, opts.min_phase, t_stop,
@@ -433,6 +464,7 @@ def _result(integrator, scene, ctrl: Controller, stepper: Stepper, ending, names
     steps = np.array([p.h for p in points[1:]])
     stats = {"tol": opts.tol, "h": opts.h, "theta": opts.theta, "solver": opts.solver,
              "compiled": stepper.engine.compiled, "force_callback": scene.applied_force is not None,
+             "unresolved_impacts": sum(len(p.impacts) for p in points) - len(impacts),
              "steps": len(points) - 1, "step_evaluations": stepper.steps_run, "rejected": ctrl.rejected,
              "taken_back": ctrl.taken_back, "forced_steps": ctrl.forced,
              "min_step": float(steps.min()) if steps.size else math.nan,

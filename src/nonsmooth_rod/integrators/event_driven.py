@@ -62,6 +62,7 @@ from ..solvers.two_coefficient import solve_two_coefficient
 from ..results import Event, Impact, SimulationResult, Trajectory, phases_from_intervals
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from ..solvers.registry import SolverName
+from . import accumulation
 from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration, Refusal, first_item
 from .sampling import OUTPUT_DT_KNOB, Thinning, grid_blocks, stop_event, stop_message, output_dt_samples
 
@@ -92,6 +93,9 @@ class EventDrivenOptions:
     impact_solver: str = option("enum", SolverName())  # the exact reference for the few contacts of an impact
     gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
     velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
+    # impacts of an accumulation are resolved while their flights rise above this (m): below, the
+    # rest of the series is summed to its accumulation time (integrators/accumulation.py); 0: all
+    resolution: float = option(0.0, Number(0.0, 1.0))
 
     def __post_init__(self):
         check_options(self)
@@ -393,6 +397,10 @@ class _Run:
     indicator_evaluations: int = 0
     last_impact_t: float = -math.inf
     rest_from: float | None = None
+    t_end: float = math.inf
+    speed_floor: float = 0.0  # at the last impact: closing speeds at or below it are not resolved
+    closing_speed: float = math.inf  # of the last impact
+    unresolved_impacts: int = 0
     instant: tuple = (math.nan, {})  # (t, forced modes) of the events at the current instant
 
     def __post_init__(self):
@@ -538,6 +546,7 @@ class EventDriven:
         wall = time.process_time()
         names = [c.name for c in scene.contacts]
         run = _Run(float(t0), q, v, Thinning(t0, save_every, stop))
+        run.t_end = float(t_end)
         # A diverging run (huge tolerances, a Painlevé blow-up) overflows inside scipy and the
         # model: no warnings on stderr, the non-finite samples end the result instead (below).
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -652,6 +661,7 @@ class EventDriven:
             run.instant = (math.nan, {})  # the impact changed the velocities: decide afresh
             if self._touchdown(scene, run, modes, i, names):
                 return None
+            return self._accumulation(scene, run, modes, self._decide_at_instant(scene, run, forced), i, names)
         new_modes = self._decide_at_instant(scene, run, forced)
         if kind == "slip-zero":
             run.events[-1].detail["to"] = new_modes[i]
@@ -690,13 +700,51 @@ class EventDriven:
             raise _Stop("zeno", f"impacts accumulate at t = {t:.12g} s (Zeno): the event-driven "
                                 "scheme cannot pass an accumulation point")
         run.last_impact_t = t
-        run.impacts.append(Impact(t, names[i], q.copy(), v_before, run.v.copy(), pN, pT))
-        run.events.append(Event(t, "impact", names[i]))
+        run.closing_speed = accumulation.closing_speed(scene, i, q, v_before)
+        run.speed_floor = accumulation.speed_floor(scene, t, q, self.options.resolution)
+        if accumulation.resolved(run.closing_speed, run.speed_floor):
+            run.impacts.append(Impact(t, names[i], q.copy(), v_before, run.v.copy(), pN, pT))
+            run.events.append(Event(t, "impact", names[i]))
+        else:  # applied, not reported: the accumulation's end follows (`_accumulation`)
+            run.unresolved_impacts += 1
         run.sample(t, np.concatenate([q, run.v]), modes)
         if self.options.stop_at_impact == names[i]:
             return True
         self._check_accumulation(scene, t, q, run.v, i)
         return False
+
+    def _accumulation(self, scene, run, before, modes, hit, names):
+        """After an impact of contact `hit` (modes `before` it, `modes` after): when every contact
+        leaving the obstacle at it (the one hit, or one closed before) leaves slower than the run's
+        speed floor, the next impacts are not resolved (integrators/accumulation.py): sum them to
+        the accumulation time and go on from there with the contacts at rest on the obstacle (the
+        series' limit). Returns the modes from where the run goes on."""
+        if run.speed_floor <= 0.0:
+            return modes
+        kin, gaps, u_N, u_T = self._local(scene, run.q, run.v)
+        u_N = u_N - np.array([k.normal_velocity for k in kin])
+        leaving = [j for j, m in enumerate(modes) if m == "open" and (j == hit or before[j] != "open")
+                   and u_N[j] > self.options.velocity_tol]
+        if not leaving or max(u_N[j] for j in leaving) > run.speed_floor:
+            return modes
+        j = max(leaving, key=lambda c: u_N[c])
+        dyn = self._dynamics(scene, run.t, run.q, run.v, modes, kin)
+        ratio = u_N[j] / run.closing_speed if run.closing_speed > 0.0 else math.inf
+        t_acc = accumulation.accumulation_time(run.t, u_N[j], float(kin[j].H_N @ dyn.a) + kin[j].drift_N, ratio)
+        if t_acc is None:
+            return modes
+        t_acc = min(t_acc, run.t_end)  # the series unfinished at t_end: its limit there, to the resolution
+        taking_part = [c for c in range(len(kin)) if c == hit or before[c] != "open" or modes[c] != "open"]
+        y = np.concatenate(accumulation.limit_state(
+            scene.inverse_mass_diagonal, [kin[c].H_N for c in taking_part], gaps[taking_part],
+            [kin[c].H_T for c in taking_part if abs(u_T[c]) <= run.speed_floor], run.q, run.v))
+        run.events.append(Event(t_acc, "accumulation", names[j], {
+            "from": run.t, "leaving_speed": float(u_N[j]), "speed_floor": run.speed_floor, "ratio": float(ratio)}))
+        for ts in grid_blocks(run.boundaries[0], self.options.output_dt, run.t, t_acc):
+            run.sample(ts, np.broadcast_to(y, (ts.size, y.size)), modes)
+        run.close(float(t_acc), y, modes)
+        run.instant = (math.nan, {})
+        return self._decide(scene, run.t, run.q, run.v)
 
     def _hold_rest(self, scene, run, modes, t_end) -> bool:
         """A body at rest (v = 0 within velocity_tol, a = 0 to round-off) in stick or flight under
@@ -781,7 +829,7 @@ class EventDriven:
             for ci, name in enumerate(names):
                 phases[name] = phases_from_intervals(run.boundaries, [m[ci] for m in run.interval_modes])
         stats = {"nfev": run.nfev, "t_final": run.t, "indicator_evaluations": run.indicator_evaluations,
-                 "rest_from": run.rest_from}
+                 "rest_from": run.rest_from, "unresolved_impacts": run.unresolved_impacts}
         return SimulationResult(self.name, status, message, traj, names, run.events, run.impacts, phases,
                                 steps=run.steps, cpu_time_s=cpu_time_s, stats=stats)
 

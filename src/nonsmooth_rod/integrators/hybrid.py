@@ -71,6 +71,8 @@ class HybridOptions:
     impact_solver: str = option("enum", Choice(available_solvers))
     gap_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m
     velocity_tol: float = option(1e-9, Number(0.0, 1e-3, open_lo=True))  # m/s
+    # flights lower than this (m) are not resolved: the reference's rule (integrators/accumulation.py)
+    resolution: float = option(0.0, Number(0.0, 1.0))
 
     def __post_init__(self):
         check_options(self)
