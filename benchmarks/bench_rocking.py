@@ -67,9 +67,10 @@ def main(argv=None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "rocking.csv", {c: [r[c] for r in rows] for c in COLUMNS}, COLUMNS)
-    print(f"resolution {rows[0]['resolution']:g} m\n\n| α | reference impacts (last, s) | {run_name} impacts (last, s) | "
-          f"evaluations | unresolved | ratio error, every impact | first impact off by > {RATIO_TOL:g} (its |θ̇|) |"
-          "\n|---|---|---|---|---|---|---|")
+    print(f"resolution {rows[0]['resolution']:g} m\n")
+    print(f"| α | reference impacts (last, s) | {run_name} impacts (last, s) | evaluations | unresolved | "
+          f"ratio error, every impact | first impact off by > {RATIO_TOL:g} (its |θ̇|) |")
+    print("|---|---|---|---|---|---|---|")
     for r in rows:
         off = "none" if r["first_off"] < 0 else f"#{r['first_off']} ({r['first_off_rate']:.1e} rad/s)"
         print(f"| {r['alpha_deg']:g}° | {r['reference_impacts']} ({r['reference_last_s']:.4f}) | {r['impacts']} "

@@ -548,9 +548,10 @@ class MoreauJean:
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
         n_done, counts = k_end - grid.first, counters.tolist()
-        stats = dict(stats, unresolved_impacts=len(collector.impact_rows) - len(impacts), steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
+        stats = dict(stats, steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
                      inconsistent_steps=counts[loop.K_INCONSISTENT], solver_fallbacks=counts[loop.K_FALLBACKS],
-                     steps_at_rest=counts[loop.K_REPEATED])
+                     steps_at_rest=counts[loop.K_REPEATED],
+                     unresolved_impacts=len(collector.impact_rows) - len(impacts))
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
                                   impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
         result.defer(locate)
