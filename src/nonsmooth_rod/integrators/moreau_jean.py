@@ -37,6 +37,7 @@ from ..solvers.two_coefficient import STATE_NAMES, solve_two_coefficient
 from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
+from .carved import carve_zeros
 from .joint_step import work_size
 from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
@@ -125,9 +126,10 @@ def _model(packed, driven_origin=None, joints=None):
 
 def _new_work(nc: int, n_dof: int, joints):
     """moreau_jean_loop's Work, zeroed: no contact closed, no memory."""
-    return loop.Work(np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
-                     np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-                     np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
+    f, i = np.float64, np.int64  # one buffer a dtype: a lent Work is zeroed by two fills (integrators/carved.py)
+    return loop.Work(*carve_zeros((((nc,), f), ((nc,), f), ((nc, 6), f), ((nc, 6), f), ((nc,), i), ((nc,), i),
+                                   ((nc,), i), ((nc,), f), ((n_dof,), f), ((n_dof,), f), ((nc,), i),
+                                   ((work_size(joints, n_dof),), f))))
 
 
 def _restore_memory(work, resume: ResumeState | None) -> None:
@@ -189,8 +191,7 @@ def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> W
 
 def _lend_window(plan, window: Window) -> None:
     """The window's records back to the scene's plan, for its next run of as many rows, when small."""
-    if sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES:
-        plan.give_back(window.rows, window.out)
+    plan.give_back(window.rows, window.out, LENT_WINDOW_BYTES)
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -306,7 +307,7 @@ class MoreauJean:
         window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
-        params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
+        params, iparams = self._run_parameters(plan, scene, grid, names)
         solver_code = SOLVER_CODES.get(opts.solver)
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
         self._motions_in_python = plan.python_motions
@@ -339,6 +340,17 @@ class MoreauJean:
         with _jit.one_blas_thread():
             return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
                                 model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
+
+    def _run_parameters(self, plan, scene, grid, names):
+        """_parameters, kept by the scene's plan for its next run with the same options object
+        (the driver hands the same checked options to runs with the same values) and start:
+        copies, for the loop writes into params."""
+        kept = plan.parameters
+        if kept is None or kept[0] is not self.options or kept[1] != grid.origin or \
+                math.copysign(1.0, kept[1]) != math.copysign(1.0, grid.origin):  # -0.0 is not 0.0
+            params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
+            kept = plan.parameters = (self.options, grid.origin, params, iparams)
+        return kept[2].copy(), kept[3].copy()
 
     def _parameters(self, scene, grid, names, varies_in_time=None):
         opts = self.options

@@ -28,6 +28,7 @@ from ..model.contacts import relation_changes
 from ..model.joints import pack_joints
 from ..model.motion import Prescribed
 from ..model.packing import pack_scene
+from .carved import owners
 
 # Scenes kept (the earliest packed first out when full) and the largest kept: beyond it
 # packing is a small part of any run, and the arrays are not worth keeping.
@@ -45,7 +46,8 @@ class ScenePlan:
     model tuple once built (`model`, only for a scene without driven motions), and per-run arrays
     lent to one run at a time (`borrow`, `give_back`)."""
 
-    __slots__ = ("packed", "joints", "names", "varies_in_time", "python_motions", "static", "model", "_spares")
+    __slots__ = ("packed", "joints", "names", "varies_in_time", "python_motions", "static", "model", "_spares",
+                 "_owners", "parameters")
 
     def __init__(self, scene):
         self.packed = pack_scene(scene)
@@ -56,25 +58,38 @@ class ScenePlan:
         self.python_motions = motions if any(isinstance(m, Prescribed) for m in motions) else []
         self.static = not scene.driven_things()  # the loop writes nothing of its packed arrays
         self.model = None
-        self._spares: dict = {}
+        self._spares: dict = {}  # key → (arrays, the buffers they are carved from)
+        self._owners: dict = {}  # key → (the arrays last lent, their buffers, their bytes)
+        self.parameters = None  # (options, t0, params, iparams) of the last run (moreau_jean._run_parameters)
 
     def borrow(self, key):
         """The arrays lent under `key` by an earlier run, zeroed, or None (none lent, or another
         run holds them: each goes to one run at a time)."""
-        arrays = self._spares.pop(key, None)
-        if arrays is not None:
-            for a in arrays:
-                a.fill(0)
+        spare = self._spares.pop(key, None)
+        if spare is None:
+            return None
+        arrays, buffers = spare
+        for buffer in buffers:  # one fill a buffer the arrays are carved from (integrators/carved.py)
+            buffer.fill(0)
         return arrays
 
-    def give_back(self, key, arrays) -> None:
-        """Lend `arrays` to the next run that asks for `key` (one set a key, MAX_SPARES keys)."""
+    def give_back(self, key, arrays, max_bytes: float = float("inf")) -> None:
+        """Lend `arrays` to the next run that asks for `key` (one set a key, MAX_SPARES keys),
+        when they hold at most `max_bytes`."""
+        known = self._owners.get(key)
+        if known is None or known[0] is not arrays:  # the same set comes back run after run
+            if len(self._owners) >= MAX_SPARES:
+                self._owners.clear()
+            buffers = owners(arrays)
+            known = self._owners[key] = (arrays, buffers, sum(b.nbytes for b in buffers))
+        if known[2] > max_bytes:
+            return
         if key not in self._spares and len(self._spares) >= MAX_SPARES:
             try:  # the earliest lent out
                 self._spares.pop(next(iter(self._spares)), None)
             except (RuntimeError, StopIteration):
                 return
-        self._spares[key] = arrays
+        self._spares[key] = (arrays, known[1])
 
 
 def _fingerprint(scene):
