@@ -189,9 +189,10 @@ def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> W
     return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk))
 
 
-def _lend_window(plan, window: Window) -> None:
-    """The window's records back to the scene's plan, for its next run of as many rows, when small."""
-    plan.give_back(window.rows, window.out, LENT_WINDOW_BYTES)
+def _lend_window(plan, window: Window, holder=None) -> bool:
+    """The window's records back to the scene's plan, for its next run of as many rows, when small;
+    True if lent (`holder`: the result whose end state is built from them on first read)."""
+    return plan.give_back(window.rows, window.out, LENT_WINDOW_BYTES, holder)
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -322,8 +323,12 @@ class MoreauJean:
                  "compiled": engine.compiled and solver_code is not None,
                  "force_callback": self._calls_back}
         result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
-        plan.give_back(WORK_KEY, work)  # the result keeps copies of what it needs from them
-        _lend_window(plan, window)
+        # lent to the next run of the scene, which first has the result copy its end state out of
+        # them if it is still alive (a loop that drops each result never copies); a window too
+        # large to lend is not kept alive by the result: its end state is copied now
+        plan.give_back(WORK_KEY, work, holder=result)
+        if not _lend_window(plan, window, result):
+            result.settle_end_state()
         return result
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
@@ -567,7 +572,10 @@ class MoreauJean:
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
-        result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
+        if status == "failed":
+            result.end_state = None
+        else:  # built on first read (run() settles it before its arrays are reused)
+            result.build_end_state(lambda: window.resume_state(grid, work, last_h, on_grid))
         return result
 
 

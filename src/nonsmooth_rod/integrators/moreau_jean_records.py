@@ -321,6 +321,8 @@ class Collector:
 
     def trajectory_arrays(self):
         n = self.n
+        if n == self.t.shape[0]:  # every sample taken (the common case): the arrays themselves
+            return self.t, self.q, self.v, self.a, self.N, self.T, self.codes
         return self.t[:n], self.q[:n], self.v[:n], self.a[:n], self.N[:n], self.T[:n], self.codes[:n]
 
     # What located_phases reads, by global step (NaN / −1 where the run has no such row).

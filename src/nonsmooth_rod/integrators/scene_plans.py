@@ -21,6 +21,7 @@ Plans and what they lend are per process: a study's workers each pack their scen
 from __future__ import annotations
 
 import dataclasses
+import weakref
 
 import numpy as np
 
@@ -58,7 +59,7 @@ class ScenePlan:
         self.python_motions = motions if any(isinstance(m, Prescribed) for m in motions) else []
         self.static = not scene.driven_things()  # the loop writes nothing of its packed arrays
         self.model = None
-        self._spares: dict = {}  # key → (arrays, the buffers they are carved from)
+        self._spares: dict = {}  # key → (arrays, the buffers they are carved from, their result's weakref)
         self._owners: dict = {}  # key → (the arrays last lent, their buffers, their bytes)
         self.parameters = None  # (options, t0, params, iparams) of the last run (moreau_jean._run_parameters)
 
@@ -68,14 +69,18 @@ class ScenePlan:
         spare = self._spares.pop(key, None)
         if spare is None:
             return None
-        arrays, buffers = spare
+        arrays, buffers, holder = spare
+        result = None if holder is None else holder()
+        if result is not None:  # a result still alive copies its end state out of them first
+            result.settle_end_state()
         for buffer in buffers:  # one fill a buffer the arrays are carved from (integrators/carved.py)
             buffer.fill(0)
         return arrays
 
-    def give_back(self, key, arrays, max_bytes: float = float("inf")) -> None:
+    def give_back(self, key, arrays, max_bytes: float = float("inf"), holder=None) -> bool:
         """Lend `arrays` to the next run that asks for `key` (one set a key, MAX_SPARES keys),
-        when they hold at most `max_bytes`."""
+        when they hold at most `max_bytes`; True if lent. `holder`: the result whose end state
+        is built from them on first read (settled before they are lent again, if it is alive)."""
         known = self._owners.get(key)
         if known is None or known[0] is not arrays:  # the same set comes back run after run
             if len(self._owners) >= MAX_SPARES:
@@ -83,13 +88,14 @@ class ScenePlan:
             buffers = owners(arrays)
             known = self._owners[key] = (arrays, buffers, sum(b.nbytes for b in buffers))
         if known[2] > max_bytes:
-            return
+            return False
         if key not in self._spares and len(self._spares) >= MAX_SPARES:
             try:  # the earliest lent out
                 self._spares.pop(next(iter(self._spares)), None)
             except (RuntimeError, StopIteration):
-                return
-        self._spares[key] = (arrays, known[1])
+                return False
+        self._spares[key] = (arrays, known[1], None if holder is None else weakref.ref(holder))
+        return True
 
 
 def _fingerprint(scene):
