@@ -213,6 +213,9 @@ class SimulationResult:
         which settles it first only if this result is still alive (integrators/scene_plans.py)."""
         self.__dict__["_build_end_state"] = build
 
+    def end_state_pending(self) -> bool:
+        return "_build_end_state" in self.__dict__
+
     def settle_end_state(self) -> None:
         build = self.__dict__.pop("_build_end_state", None)
         if build is not None:
