@@ -251,7 +251,8 @@ class _BuiltOnRead:
         if result is None:
             return self
         result.settle_end_state()
-        return result.__dict__["_end_state"]
+        fields = result.__dict__
+        return fields["_end_state"] if "_end_state" in fields else fields.get("end_state")  # (an older pickle's)
 
     def __set__(self, result, value):
         result.__dict__.pop("_build_end_state", None)
