@@ -39,9 +39,12 @@ def _choose_cache_dir() -> None:
 _choose_cache_dir()
 
 import importlib.util
+import sys
 
-# numba is the optional `fast` extra; it is imported only when a kernel is first decorated, so
-# `import nonsmooth_rod` stays light.
+# numba is the optional `fast` extra. It is imported on the first compiled call, not by the
+# decorators: `import nonsmooth_rod` stays light (numba, llvmlite, yaml and scipy cost ~0.2 s of
+# an idle start), and runs that never compile (interpreted, event-driven, the CLI's help) never
+# load it.
 HAVE_NUMBA = importlib.util.find_spec("numba") is not None
 ENABLED = HAVE_NUMBA and os.environ.get("NONSMOOTH_ROD_NO_JIT", "") in ("", "0")
 _warned = False
@@ -70,15 +73,9 @@ def jit(function):
 
     Kernels take float64 arrays and int64 indices only, so each compiles to one signature.
     """
-    if not ENABLED:
-        return function
-    import numba
-
-    if not _purged:
-        purge_stale_kernels()
     # NRT set here, not inherited: a function the step's borrowing ones call keeps its reference
     # counting (numba's callees inherit an unset NRT flag from their caller)
-    return numba.njit(cache=True, _nrt=True)(function)
+    return _kernel(function, {"cache": True, "_nrt": True}) if ENABLED else function
 
 
 def jit_borrowing(function):
@@ -88,39 +85,111 @@ def jit_borrowing(function):
     step's long functions its pruning pass leaves most of them: ~300 a step for one contact, most of
     the step's time (measured with gdb on NRT_incref). Such a function must not allocate, and
     must not return an array or take one from a function that allocates it."""
-    if not ENABLED:
-        return function
-    import numba
-
-    if not _purged:
-        purge_stale_kernels()
-    return numba.njit(cache=True, _nrt=False)(function)
+    return _kernel(function, {"cache": True, "_nrt": False}) if ENABLED else function
 
 
 def jit_inline(function):
     """jit, inlined into its callers at numba's IR level: small helpers (a scratch view, a
     relative velocity, a Delassus block) compiled as part of the function that calls them, with
     its reference counting or without it (in a borrowing caller they count nothing either)."""
-    if not ENABLED:
-        return function
-    import numba
-
-    if not _purged:
-        purge_stale_kernels()
-    return numba.njit(cache=True, inline="always")(function)
+    return _kernel(function, {"cache": True, "inline": "always"}) if ENABLED else function
 
 
 def jitable(function):
     """A kernel both ways: plain Python when Python calls it (it never waits for a compile), and
-    compiled into the jitted kernels that call it (numba's register_jitable). For code that the
-    compiled loop and the object model share (model/contact_kernels.py)."""
-    if not ENABLED:
-        return function
-    from numba.extending import register_jitable
+    compiled into the jitted kernels that call it (numba's register_jitable, once numba is loaded).
+    For code that the compiled loop and the object model share (model/contact_kernels.py)."""
+    if ENABLED:
+        if _numba is None:
+            _pending_jitable.append(function)
+        else:
+            _numba.extending.register_jitable(function)
+    return function
+
+
+# ---------------------------------------------------------------- numba on first use
+_numba = None  # the numba module once loaded
+_pending_jitable: list = []  # jitable functions to register with numba when it loads
+_lazy_kernels: list = []  # LazyKernels made before numba loaded
+
+
+class LazyKernel:
+    """A compiled kernel before numba is loaded: `py_func` (what solvers._common.interpreted
+    runs) without numba; called, or typed by numba inside a caller being compiled (its
+    `_numba_type_`), it loads numba, which makes every kernel's dispatcher and rebinds the
+    package's module globals to them (`load_numba`) — from then on the kernels are numba's own."""
+
+    __slots__ = ("py_func", "options", "dispatcher", "__weakref__")
+
+    def __init__(self, function, options: dict):
+        self.py_func, self.options, self.dispatcher = function, options, None
+
+    def materialized(self):
+        if self.dispatcher is None:
+            load_numba()
+        return self.dispatcher
+
+    def __call__(self, *args):
+        return self.materialized()(*args)
+
+    @property
+    def _numba_type_(self):
+        return self.materialized()._numba_type_
+
+    def __getattr__(self, name):  # the dispatcher's attributes (compile, signatures, _cache...)
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(self.materialized(), name)
+
+    def __reduce__(self):  # pickled as what it stands for: its module's attribute
+        return _module_attribute, (self.py_func.__module__, self.py_func.__name__)
+
+    def __repr__(self):
+        return f"<kernel {self.py_func.__module__}.{self.py_func.__qualname__} (numba not loaded yet)>"
+
+
+def _module_attribute(module: str, name: str):
+    import importlib
+
+    return getattr(importlib.import_module(module), name)
+
+
+def _kernel(function, options: dict):
+    """numba's dispatcher of `function` when numba is loaded, else a LazyKernel standing for it."""
+    if _numba is not None:
+        return _numba.njit(**options)(function)
+    kernel = LazyKernel(function, options)
+    _lazy_kernels.append(kernel)
+    return kernel
+
+
+def load_numba():
+    """Load numba (once): the stale cached kernels purged first, the jitable functions
+    registered, every LazyKernel's dispatcher made, and the package modules' globals that name
+    a LazyKernel rebound to its dispatcher (Python calls then go straight to numba)."""
+    global _numba
+    if _numba is not None:
+        return _numba
+    import numba
+    import numba.extending
 
     if not _purged:
         purge_stale_kernels()
-    return register_jitable(function)
+    for function in _pending_jitable:
+        numba.extending.register_jitable(function)
+    _pending_jitable.clear()
+    for kernel in _lazy_kernels:
+        kernel.dispatcher = numba.njit(**kernel.options)(kernel.py_func)
+    _numba = numba
+    package = __name__.rpartition(".")[0]
+    for name, module in list(sys.modules.items()):
+        if module is not None and (name == package or name.startswith(package + ".")):
+            space = vars(module)
+            for key, value in list(space.items()):
+                if type(value) is LazyKernel:
+                    space[key] = value.dispatcher
+    _lazy_kernels.clear()
+    return numba
 
 
 # ---------------------------------------------------------------- stale cached kernels
@@ -253,9 +322,11 @@ _blas_depth = 0  # nested uses (a sweep's batch around its runs) limit and resto
 
 class one_blas_thread:
     """Context manager: BLAS/LAPACK (numpy's and scipy's OpenBLAS, which numba's kernels call) on
-    one thread inside, the previous limits restored after. The libraries are looked up once per
-    process (threadpoolctl); entering then costs two ctypes calls per library (~1 µs), and nested
-    inside another use it is free — so a sweep wraps its whole batch once, not each short run."""
+    one thread inside, the previous limits restored after. The libraries and their thread-count
+    functions are looked up once per process (threadpoolctl); entering then costs two ctypes calls
+    per library and leaving one (~1 µs in all: threadpoolctl's own methods cost ~13 µs, 4
+    yardsticks of a short run's fixed cost), and nested inside another use it is free — so a
+    sweep wraps its whole batch once, not each short run."""
 
     def __enter__(self):
         global _blas, _blas_depth
@@ -266,30 +337,40 @@ class one_blas_thread:
         if _blas is None:
             _blas = _blas_libraries()
         restore = []
-        for library in _blas:
-            threads = library.num_threads
+        for get_threads, set_threads in _blas:
+            threads = get_threads()
             if threads != 1:
-                library.set_num_threads(1)
-                restore.append((library, threads))
+                set_threads(1)
+                restore.append((set_threads, threads))
         self._restore = restore
         return self
 
     def __exit__(self, exc_type, exc, tb):
         global _blas_depth
         _blas_depth -= 1
-        for library, threads in self._restore:
-            library.set_num_threads(threads)
+        for set_threads, threads in self._restore:
+            set_threads(threads)
         return False
 
 
 def _blas_libraries() -> list:
-    """threadpoolctl's controllers of the loaded BLAS libraries ([] without threadpoolctl)."""
+    """(get, set) thread-count functions of each loaded BLAS library ([] without threadpoolctl):
+    OpenBLAS's own C functions where threadpoolctl finds them (a run holds the limit on the one
+    thread it runs on: threadpoolctl's bookkeeping of which Python thread controls the pool is
+    for its own context managers), threadpoolctl's methods otherwise."""
     try:
         import scipy.linalg.cython_lapack  # noqa: F401  (the LAPACK numba's kernels call)
         from threadpoolctl import ThreadpoolController
     except ImportError:
         return []
-    return list(ThreadpoolController().select(user_api="blas").lib_controllers)
+    found = []
+    for library in ThreadpoolController().select(user_api="blas").lib_controllers:
+        symbol = getattr(library, "_get_symbol", None)
+        direct = None
+        if symbol is not None and library.internal_api == "openblas" and library.threading_layer != "openmp":
+            direct = symbol("openblas_get_num_threads"), symbol("openblas_set_num_threads")
+        found.append(direct if direct and None not in direct else (library.get_num_threads, library.set_num_threads))
+    return found
 
 
 # ---------------------------------------------------------------- when to compile
@@ -329,6 +410,8 @@ def engine_is_warm(part: str = "engine") -> bool:
     """True when the part's compiled kernels are (very likely) in the on-disk cache."""
     if not ENABLED or part in _warm:
         return True
+    if not _purged:  # a marker of kernels compiled from older sources is dropped first
+        purge_stale_kernels()
     if _marker(part).exists():
         _warm.add(part)
         return True

@@ -207,8 +207,23 @@ class SimulationResult:
         if locate is not None:
             locate(self)
 
-    def __getstate__(self):  # pickled (a sweep's worker) with its phases located, not the closure
+    def build_end_state(self, build) -> None:
+        """Leave `end_state` to `build()`, run when it is first read (or by `settle_end_state`):
+        a short run's end state is copied from arrays its scene's plan lends to the next run,
+        which settles it first only if this result is still alive (integrators/scene_plans.py)."""
+        self.__dict__["_build_end_state"] = build
+
+    def end_state_pending(self) -> bool:
+        return "_build_end_state" in self.__dict__
+
+    def settle_end_state(self) -> None:
+        build = self.__dict__.pop("_build_end_state", None)
+        if build is not None:
+            self.__dict__["_end_state"] = build()
+
+    def __getstate__(self):  # pickled (a sweep's worker) with its phases located, not the closures
         self._settle()
+        self.settle_end_state()
         return self.__dict__
 
 
@@ -229,10 +244,26 @@ class _Deferred:
         result.__dict__[self.slot] = value
 
 
+class _BuiltOnRead:
+    """SimulationResult.end_state: built on first read when `build_end_state` left it to a function."""
+
+    def __get__(self, result, owner=None):
+        if result is None:
+            return self
+        result.settle_end_state()
+        fields = result.__dict__
+        return fields["_end_state"] if "_end_state" in fields else fields.get("end_state")  # (an older pickle's)
+
+    def __set__(self, result, value):
+        result.__dict__.pop("_build_end_state", None)
+        result.__dict__["_end_state"] = value
+
+
 for _name in ("events", "phases"):  # after @dataclass: its __init__ assigns them through these
     _field = _Deferred()
     _field.__set_name__(SimulationResult, _name)
     setattr(SimulationResult, _name, _field)
+SimulationResult.end_state = _BuiltOnRead()
 
 
 def phases_from_intervals(t_bounds, modes, min_duration: float = 0.0) -> list[Phase]:

@@ -82,6 +82,22 @@ def test_a_kept_result_is_not_changed_by_the_next_runs():
     assert all(same_bits(getattr(first.end_state, k), v) for k, v in kept.items())
 
 
+def test_an_end_state_first_read_after_later_runs_is_its_own_runs():
+    """A short run's end state is built on first read from the arrays its plan lends to the next
+    run, which has it copied out first while the result is alive: read only after three more runs
+    of the scene (other numbers), it is the end state of the same run of a scene packed afresh."""
+    scene = ball_scene()
+    first = run(scene)
+    # the same window length, every result kept: the plan's sets are all still read, so the third
+    # run reuses first's arrays
+    later = [nr.simulate(scene, Q0, v0, T_END, h=H) for v0 in (-V0, 2 * V0, 0.5 * V0)]
+    want = run(ball_scene()).end_state
+    for name in ("q", "v", "p_normal", "p_tangent", "slip", "states", "was_closed", "grazing", "slip_sign"):
+        assert same_bits(getattr(first.end_state, name), getattr(want, name)), name
+    assert (first.end_state.step, first.end_state.origin) == (want.step, want.origin)
+    assert same_bits(later[0].end_state.v, nr.simulate(ball_scene(), Q0, -V0, T_END, h=H).end_state.v)
+
+
 @pytest.mark.parametrize("change", ["law", "radius", "line", "contacts list", "weight in place", "forces"])
 def test_a_change_of_the_scene_between_runs_is_seen(change):
     """Each change gives the run of a scene built with it from the start, not the kept plan's."""
@@ -156,12 +172,14 @@ def test_the_arrays_a_plan_lends_are_bounded():
     from nonsmooth_rod.integrators.moreau_jean_records import Window
 
     scene = ball_scene()
-    for steps in range(5, 5 + 3 * scene_plans.MAX_SPARES):
-        nr.simulate(scene, Q0, V0, steps * H, h=H)
+    kept = [nr.simulate(scene, Q0, V0, steps * H, h=H) for steps in range(5, 5 + 3 * scene_plans.MAX_SPARES)]
+    kept += [nr.simulate(scene, Q0, V0, 5 * H, h=H) for _ in range(3)]  # results kept: a second set, not more
     plan = scene_plan(scene)
     assert len(plan._spares) == scene_plans.MAX_SPARES
     long_window = Window(scene.n_dof, 1, 50_000)
     _lend_window(plan, long_window)
     assert long_window.rows not in plan._spares
-    taken = plan.borrow("work")
-    assert taken is not None and plan.borrow("work") is None  # one run at a time
+    del kept  # their results gone: every set free
+    taken = [plan.borrow("work") for _ in range(scene_plans.SETS_PER_KEY)]
+    assert all(t is not None for t in taken) and plan.borrow("work") is None  # each set to one run at a time
+    assert len({id(t) for t in taken}) == scene_plans.SETS_PER_KEY

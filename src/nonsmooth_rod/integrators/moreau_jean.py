@@ -38,6 +38,7 @@ from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import accumulation
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
+from .carved import carve_zeros
 from .joint_step import work_size
 from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
@@ -129,9 +130,10 @@ def _model(packed, driven_origin=None, joints=None):
 
 def _new_work(nc: int, n_dof: int, joints):
     """moreau_jean_loop's Work, zeroed: no contact closed, no memory."""
-    return loop.Work(np.zeros(nc), np.zeros(nc), np.zeros((nc, 6)), np.zeros((nc, 6)), np.zeros(nc, dtype=np.int64),
-                     np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.zeros(nc), np.zeros(n_dof),
-                     np.zeros(n_dof), np.zeros(nc, dtype=np.int64), np.zeros(work_size(joints, n_dof)))
+    f, i = np.float64, np.int64  # one buffer a dtype: a lent Work is zeroed by two fills (integrators/carved.py)
+    return loop.Work(*carve_zeros((((nc,), f), ((nc,), f), ((nc, 6), f), ((nc, 6), f), ((nc,), i), ((nc,), i),
+                                   ((nc,), i), ((nc,), f), ((n_dof,), f), ((n_dof,), f), ((nc,), i),
+                                   ((work_size(joints, n_dof),), f))))
 
 
 def _restore_memory(work, resume: ResumeState | None) -> None:
@@ -191,10 +193,10 @@ def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> W
     return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk))
 
 
-def _lend_window(plan, window: Window) -> None:
-    """The window's records back to the scene's plan, for its next run of as many rows, when small."""
-    if sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES:
-        plan.give_back(window.rows, window.out)
+def _lend_window(plan, window: Window, holder=None) -> bool:
+    """The window's records back to the scene's plan, for its next run of as many rows, when small;
+    True if lent (`holder`: the result whose end state is built from them on first read)."""
+    return plan.give_back(window.rows, window.out, LENT_WINDOW_BYTES, holder)
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -310,7 +312,7 @@ class MoreauJean:
         window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
-        params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
+        params, iparams = self._run_parameters(plan, scene, grid, names)
         solver_code = SOLVER_CODES.get(opts.solver)
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
         self._motions_in_python = plan.python_motions
@@ -325,8 +327,12 @@ class MoreauJean:
                  "compiled": engine.compiled and solver_code is not None,
                  "force_callback": self._calls_back}
         result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
-        plan.give_back(WORK_KEY, work)  # the result keeps copies of what it needs from them
-        _lend_window(plan, window)
+        # lent to the next run of the scene, which first has the result copy its end state out of
+        # them if it is still alive (a loop that drops each result never copies); a window too
+        # large to lend is not kept alive by the result: its end state is copied now
+        plan.give_back(WORK_KEY, work, holder=result)
+        if not _lend_window(plan, window, result):
+            result.settle_end_state()
         return result
 
     def _run_with_tol(self, scene, q0, v0, t_end, t0, resume, save_every, stop, names) -> SimulationResult:
@@ -343,6 +349,17 @@ class MoreauJean:
         with _jit.one_blas_thread():
             return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
                                 model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
+
+    def _run_parameters(self, plan, scene, grid, names):
+        """_parameters, kept by the scene's plan for its next run with the same options object
+        (the driver hands the same checked options to runs with the same values) and start:
+        copies, for the loop writes into params."""
+        kept = plan.parameters
+        if kept is None or kept[0] is not self.options or kept[1] != grid.origin or \
+                math.copysign(1.0, kept[1]) != math.copysign(1.0, grid.origin):  # -0.0 is not 0.0
+            params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
+            kept = plan.parameters = (self.options, grid.origin, params, iparams)
+        return kept[2].copy(), kept[3].copy()
 
     def _parameters(self, scene, grid, names, varies_in_time=None):
         opts = self.options
@@ -562,7 +579,10 @@ class MoreauJean:
         on_grid = k_end < grid.last or not grid.h_last
         last_h = grid.h_last if k_end == grid.last and grid.h_last else (
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
-        result.end_state = window.resume_state(grid, work, last_h, on_grid) if status != "failed" else None
+        if status == "failed":
+            result.end_state = None
+        else:  # built on first read (run() settles it before its arrays are reused)
+            result.build_end_state(lambda: window.resume_state(grid, work, last_h, on_grid))
         return result
 
 

@@ -34,6 +34,7 @@ from ..model.contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OBSTACL
                                       C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
                                       KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
 from ..model.forces import accumulate_forces
+from .carved import carve_zeros
 from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
 from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
@@ -129,11 +130,10 @@ Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints spars
 def new_records(n_dof, n_contacts, rows, impacts, joint_rows):
     """Records of `rows` steps (rows + 1 states), room for `impacts` impacts, `joint_rows` joint
     impulses a step: the one constructor of the loop's `out` (moreau_jean_records.Window, adaptive)."""
-    per_step = (rows, n_contacts)
-    return Records(np.zeros((rows + 1, n_dof)), np.zeros((rows + 1, n_dof)), np.zeros(per_step), np.zeros(per_step),
-                   np.zeros(per_step), np.zeros(per_step, dtype=np.int64), np.zeros(impacts),
-                   np.zeros(impacts, dtype=np.int64), np.zeros(impacts, dtype=np.int64),
-                   np.zeros(N_COUNTERS, dtype=np.int64), np.zeros((rows, joint_rows)))
+    per_step, f, i = (rows, n_contacts), np.float64, np.int64  # one buffer a dtype (integrators/carved.py)
+    return Records(*carve_zeros((((rows + 1, n_dof), f), ((rows + 1, n_dof), f), (per_step, f), (per_step, f),
+                                 (per_step, f), (per_step, i), ((impacts,), f), ((impacts,), i), ((impacts,), i),
+                                 ((N_COUNTERS,), i), ((rows, joint_rows), f))))
 
 
 @_inlined

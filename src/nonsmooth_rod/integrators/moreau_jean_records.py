@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
@@ -108,14 +107,11 @@ class Grid:
         t_before = origin + (first + n - 1) * h
         return cls(origin, first, n - 1, h, t_end - t_before, t_end)
 
-    # (computed once: a grid is never changed after Grid.of, and a run reads these a dozen times)
-    @cached_property
-    def n_steps(self) -> int:
-        return self.n_full + (1 if self.h_last else 0)
-
-    @cached_property
-    def last(self) -> int:
-        return self.first + self.n_steps
+    def __post_init__(self):
+        # plain attributes, computed once: a grid is never changed after Grid.of, a run reads them a
+        # dozen times, and a cached property's first read (its lock) costs more than computing both
+        self.n_steps: int = self.n_full + (1 if self.h_last else 0)
+        self.last: int = self.first + self.n_steps
 
     def time(self, k: np.ndarray | int):
         """Times of global step indices (the last one: t_end exactly)."""
@@ -325,6 +321,8 @@ class Collector:
 
     def trajectory_arrays(self):
         n = self.n
+        if n == self.t.shape[0]:  # every sample taken (the common case): the arrays themselves
+            return self.t, self.q, self.v, self.a, self.N, self.T, self.codes
         return self.t[:n], self.q[:n], self.v[:n], self.a[:n], self.N[:n], self.T[:n], self.codes[:n]
 
     # What located_phases reads, by global step (NaN / −1 where the run has no such row).

@@ -21,6 +21,7 @@ Plans and what they lend are per process: a study's workers each pack their scen
 from __future__ import annotations
 
 import dataclasses
+import weakref
 
 import numpy as np
 
@@ -28,6 +29,7 @@ from ..model.contacts import relation_changes
 from ..model.joints import pack_joints
 from ..model.motion import Prescribed
 from ..model.packing import pack_scene
+from .carved import owners
 
 # Scenes kept (the earliest packed first out when full) and the largest kept: beyond it
 # packing is a small part of any run, and the arrays are not worth keeping.
@@ -35,6 +37,7 @@ MAX_PLANS = 8
 MAX_PLAN_CONTACTS = 4096
 # Sets of per-run arrays a plan lends (the Work, windows of a few lengths).
 MAX_SPARES = 4
+SETS_PER_KEY = 2  # sets lent a key: the last result can keep its arrays while the next run takes the other
 _PLANS: dict = {}  # id(scene) → (scene, fingerprint, what the fingerprint's ids name, plan, checked)
 _IMMUTABLE = (float, int, str, bool, type(None))
 
@@ -45,7 +48,8 @@ class ScenePlan:
     model tuple once built (`model`, only for a scene without driven motions), and per-run arrays
     lent to one run at a time (`borrow`, `give_back`)."""
 
-    __slots__ = ("packed", "joints", "names", "varies_in_time", "python_motions", "static", "model", "_spares")
+    __slots__ = ("packed", "joints", "names", "varies_in_time", "python_motions", "static", "model", "_spares",
+                 "_owners", "parameters")
 
     def __init__(self, scene):
         self.packed = pack_scene(scene)
@@ -56,25 +60,58 @@ class ScenePlan:
         self.python_motions = motions if any(isinstance(m, Prescribed) for m in motions) else []
         self.static = not scene.driven_things()  # the loop writes nothing of its packed arrays
         self.model = None
-        self._spares: dict = {}
+        self._spares: dict = {}  # key → [(arrays, the buffers they are carved from, their result's weakref)]
+        self._owners: dict = {}  # id(arrays) → (arrays, their buffers, their bytes)
+        self.parameters = None  # (options, t0, params, iparams) of the last run (moreau_jean._run_parameters)
 
     def borrow(self, key):
-        """The arrays lent under `key` by an earlier run, zeroed, or None (none lent, or another
-        run holds them: each goes to one run at a time)."""
-        arrays = self._spares.pop(key, None)
-        if arrays is not None:
-            for a in arrays:
-                a.fill(0)
+        """A set of arrays lent under `key` by an earlier run, zeroed, or None (none lent, or other
+        runs hold them: each set goes to one run at a time). Of the SETS_PER_KEY sets, one whose
+        result is gone or has its end state is taken first; else the earliest, once its result has
+        copied its end state out of it."""
+        sets = self._spares.get(key)
+        if not sets:
+            return None
+        for i, (_, _, holder) in enumerate(sets):
+            result = None if holder is None else holder()
+            if result is None or not result.end_state_pending():
+                break
+        else:  # every set still read by a result: a new set while there are fewer than SETS_PER_KEY
+            if len(sets) < SETS_PER_KEY:
+                return None
+            i = 0
+        arrays, buffers, holder = sets.pop(i)
+        result = None if holder is None else holder()
+        if result is not None:
+            result.settle_end_state()
+        for buffer in buffers:  # one fill a buffer the arrays are carved from (integrators/carved.py)
+            buffer.fill(0)
         return arrays
 
-    def give_back(self, key, arrays) -> None:
-        """Lend `arrays` to the next run that asks for `key` (one set a key, MAX_SPARES keys)."""
+    def give_back(self, key, arrays, max_bytes: float = float("inf"), holder=None) -> bool:
+        """Lend `arrays` to the next run that asks for `key` (SETS_PER_KEY sets a key, MAX_SPARES
+        keys), when they hold at most `max_bytes`; True if lent. `holder`: the result whose end
+        state is built from them on first read (settled before they are lent again, if it is
+        alive): two sets a key, so that a loop that keeps each result until the next call returns
+        never has one copied."""
+        known = self._owners.get(id(arrays))
+        if known is None or known[0] is not arrays:  # the same sets come back run after run
+            if len(self._owners) >= SETS_PER_KEY * MAX_SPARES:
+                self._owners.clear()
+            buffers = owners(arrays)
+            known = self._owners[id(arrays)] = (arrays, buffers, sum(b.nbytes for b in buffers))
+        if known[2] > max_bytes:
+            return False
         if key not in self._spares and len(self._spares) >= MAX_SPARES:
             try:  # the earliest lent out
                 self._spares.pop(next(iter(self._spares)), None)
             except (RuntimeError, StopIteration):
-                return
-        self._spares[key] = arrays
+                return False
+        sets = self._spares.setdefault(key, [])
+        if len(sets) >= SETS_PER_KEY:
+            sets.pop(0)  # not lent again: its result, if any, keeps it
+        sets.append((arrays, known[1], None if holder is None else weakref.ref(holder)))
+        return True
 
 
 def _fingerprint(scene):
