@@ -1,22 +1,42 @@
-"""The hybrid method (integrators/hybrid.py) on 25 rods with (μs, μd) drawn over 0.05–0.6 (μd ≤ μs,
-seed 0), against the event-driven reference at rtol 1e-12: the phase sequence of ball A, the
-largest phase boundary error and ball B's impact error, at each h.
+"""The hybrid method (integrators/hybrid.py) and error-controlled Moreau–Jean (integrators/
+adaptive.py, `tol=`) on 25 rods with (μs, μd) drawn over 0.05–0.6 (μd ≤ μs, seed 0), against the
+event-driven reference at rtol 1e-12: the phase sequence of ball A, the largest phase boundary
+error and ball B's impact error, the work and the cost, for each h (hybrid) and each tol.
 
-    python benchmarks/bench_hybrid_cases.py [--h 1e-2 5e-2]
+    python benchmarks/bench_hybrid_cases.py [--h 1e-2 5e-2] [--tol 1e-5 1e-6] [--cases 0 1 ...]
+                                            [--quick] [--out DIR]
 
-Prints a markdown table (docs/error_control.md quotes it); exits 1 if a phase sequence is wrong.
+Prints a markdown table (docs/error_control.md quotes it), one row per run; with --out, also
+DIR/hybrid_cases.csv, one row per case and run. Work: steps (hybrid) or step evaluations (tol,
+every step of every window run, taken back or not); cost: CPU time of the whole call, median over
+the cases, in yardsticks measured in the same run (benchmarks/yardstick.py). --quick: cases 1, 5 and 9
+(ball A's three sequences among the 25: slip−; stick, slip+; stick, slip−, slip+), hybrid h = 5e-2
+and tol = 1e-6 (a test runs it). Exits 1 if a
+phase sequence is wrong, or if a tol run has a boundary or the impact off by more than 10 tol.
 """
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+import time
+from pathlib import Path
 
 import numpy as np
 
-from nonsmooth_rod.rod.problem import RodProblem
-from nonsmooth_rod.rod.simulation import simulate
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from yardstick import yardstick_us  # noqa: E402
+
+from nonsmooth_rod.io import write_csv  # noqa: E402
+from nonsmooth_rod.rod.problem import RodProblem  # noqa: E402
+from nonsmooth_rod.rod.simulation import simulate  # noqa: E402
 
 N_CASES = 25
+QUICK_CASES = (1, 5, 9)
+TOL_BOUND = 10  # a tol run must have every boundary and the impact within TOL_BOUND · tol (issue 28: 1e-5 at 1e-6)
+COLUMNS = ("run", "value", "case", "mu_s", "mu_d", "phases", "reference_phases", "ok", "boundary_error_s",
+           "impact_error_s", "work", "cpu_s")
 
 
 def cases(seed: int = 0) -> list[tuple[float, float]]:
@@ -25,28 +45,77 @@ def cases(seed: int = 0) -> list[tuple[float, float]]:
     return [(float(max(a, b)), float(min(a, b))) for a, b in pairs]
 
 
-def compare(mu_s: float, mu_d: float, reference, h: float) -> dict:
-    run = simulate(RodProblem.paper(None, mu_s=mu_s, mu_d=mu_d), "hybrid", h=h)
-    ok = [p.mode for p in run.phases] == [p.mode for p in reference.phases]
+def compare(mu_s: float, mu_d: float, reference, run_name: str, value: float) -> dict:
+    """One run ("hybrid" with h = value, or "tol": Moreau–Jean with tol = value) against the reference."""
+    problem = RodProblem.paper(None, mu_s=mu_s, mu_d=mu_d)
+    started = time.process_time()
+    run = (simulate(problem, "hybrid", h=value) if run_name == "hybrid"
+           else simulate(problem, "moreau-jean", tol=value))
+    cpu = time.process_time() - started
+    got, expected = [p.mode for p in run.phases], [p.mode for p in reference.phases]
+    ok = got == expected
     boundary = max(abs(a.t_end - b.t_end) for a, b in zip(run.phases, reference.phases)) if ok else np.inf
     impact = abs(run.impact["t"] - reference.impact["t"]) if run.impact and reference.impact else np.nan
-    return {"ok": ok, "boundary": boundary, "impact": impact, "steps": run.result.steps}
+    return {"run": run_name, "value": value, "mu_s": mu_s, "mu_d": mu_d, "phases": " ".join(got),
+            "reference_phases": " ".join(expected), "ok": ok, "boundary_error_s": boundary, "impact_error_s": impact,
+            "work": run.result.stats.get("step_evaluations", run.result.steps), "cpu_s": cpu}
+
+
+def row(rows: list[dict], yardstick: float) -> str:
+    r0 = rows[0]
+    knob = f"hybrid h = {r0['value']:g}" if r0["run"] == "hybrid" else f"Moreau–Jean tol = {r0['value']:g}"
+    wrong = [r["case"] for r in rows if not r["ok"]]
+    return (f"| {knob} | {len(rows) - len(wrong)}/{len(rows)}" + (f" (wrong: {wrong})" if wrong else "") +
+            f" | {max(r['boundary_error_s'] for r in rows):.1e} | {np.nanmax([r['impact_error_s'] for r in rows]):.1e}"
+            f" | {np.median([r['work'] for r in rows]):.0f} ({max(r['work'] for r in rows)})"
+            f" | {np.median([r['cpu_s'] for r in rows]) * 1e6 / yardstick:.0f} |")
+
+
+def missed(r: dict) -> bool:
+    if not r["ok"]:
+        return True
+    bound = TOL_BOUND * r["value"] if r["run"] == "tol" else math.inf
+    return not (r["boundary_error_s"] <= bound and r["impact_error_s"] <= bound)
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--h", type=float, nargs="+", default=[1e-2, 5e-2])
+    parser.add_argument("--h", type=float, nargs="*", default=None, help="hybrid steps (default 1e-2 5e-2)")
+    parser.add_argument("--tol", type=float, nargs="*", default=[], help="Moreau–Jean tolerances")
+    parser.add_argument("--cases", type=int, nargs="+", default=None, help="case indices (default all 25)")
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--out", default=None)
     args = parser.parse_args(argv)
-    references = {c: simulate(RodProblem.paper(None, mu_s=c[0], mu_d=c[1]), "event-driven") for c in cases()}
-    print("| h (s) | right phase sequences | largest boundary error (s) | largest impact error (s) | steps (median) |\n"
-          "|---|---|---|---|---|")
-    wrong = 0
-    for h in args.h:
-        rows = [compare(*c, ref, h) for c, ref in references.items()]
-        wrong += sum(not r["ok"] for r in rows)
-        print(f"| {h:g} | {sum(r['ok'] for r in rows)}/{len(rows)} | {max(r['boundary'] for r in rows):.1e} | "
-              f"{np.nanmax([r['impact'] for r in rows]):.1e} | {np.median([r['steps'] for r in rows]):.0f} |")
-    return 1 if wrong else 0
+    steps = args.h if args.h is not None else ([5e-2] if args.quick else [1e-2, 5e-2])
+    tols = args.tol or ([1e-6] if args.quick else [])
+    chosen = args.cases if args.cases is not None else (list(QUICK_CASES) if args.quick else list(range(N_CASES)))
+    all_cases = cases()
+    references = {i: simulate(RodProblem.paper(None, mu_s=all_cases[i][0], mu_d=all_cases[i][1]), "event-driven")
+                  for i in chosen}
+    if tols:
+        simulate(RodProblem.paper(), "moreau-jean", tol=1e-2)  # warm: compile or load the loop once
+    simulate(RodProblem.paper(), "hybrid")  # warm: its kernels and imports
+    runs = [("hybrid", h) for h in steps] + [("tol", t) for t in tols]
+    table = []
+    for name, value in runs:
+        table.append([dict(compare(*all_cases[i], references[i], name, value), case=i) for i in chosen])
+    yardstick = yardstick_us()
+    print(f"yardstick {yardstick:.2f} µs (the machine is shared: compare columns, not absolute times)\n\n"
+          "| run | right phase sequences | largest boundary error (s) | largest impact error (s) | "
+          "work: median (largest) | yardsticks (median) |\n|---|---|---|---|---|---|")
+    for rows in table:
+        print(row(rows, yardstick))
+    flat = [r for rows in table for r in rows]
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        write_csv(out / "hybrid_cases.csv", {c: [r[c] for r in flat] for c in COLUMNS}, COLUMNS)
+    for r in flat:
+        if missed(r):
+            print(f"case {r['case']} (μs {r['mu_s']:.4f}, μd {r['mu_d']:.4f}) {r['run']} {r['value']:g}: "
+                  f"{r['phases']} (reference {r['reference_phases']}), boundary {r['boundary_error_s']:.2e} s, "
+                  f"impact {r['impact_error_s']:.2e} s")
+    return 1 if any(missed(r) for r in flat) else 0
 
 
 if __name__ == "__main__":

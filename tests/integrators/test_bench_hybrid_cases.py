@@ -1,0 +1,29 @@
+"""benchmarks/bench_hybrid_cases.py's quick mode (issue 28's "25 hidden-style cases"): on three of
+the 25 rods, one of each phase sequence of ball A, the hybrid method at h = 5e-2 and
+error-controlled Moreau–Jean at tol = 1e-6 have the event-driven reference's phase sequence, and
+at tol = 1e-6 every phase boundary and ball B's impact are within 1e-5 s of the reference's."""
+import csv
+from pathlib import Path
+
+from scripts import load_script
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _bench():
+    return load_script(ROOT / "benchmarks" / "bench_hybrid_cases.py")
+
+
+def test_quick_run_has_the_references_phases_and_boundaries_within_1e_5_s_at_tol_1e_6(tmp_path, capsys):
+    bench = _bench()
+    assert bench.main(["--quick", "--out", str(tmp_path)]) == 0  # 1 on a wrong sequence or a tol run off by > 10 tol
+    rows = list(csv.DictReader((tmp_path / "hybrid_cases.csv").open()))
+    assert [(r["run"], float(r["value"]), int(r["case"])) for r in rows] == \
+        [("hybrid", 5e-2, i) for i in bench.QUICK_CASES] + [("tol", 1e-6, i) for i in bench.QUICK_CASES]
+    # the three cases cover the three sequences the 25 have (slip−; stick, slip+; stick, slip−, slip+)
+    assert len({r["reference_phases"] for r in rows}) == 3
+    for r in rows:
+        assert r["phases"] == r["reference_phases"]
+        if r["run"] == "tol":
+            assert float(r["boundary_error_s"]) <= 1e-5 and float(r["impact_error_s"]) <= 1e-5
+    assert "| Moreau–Jean tol = 1e-06 | 3/3 |" in capsys.readouterr().out
