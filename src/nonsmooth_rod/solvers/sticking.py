@@ -51,14 +51,17 @@ REUSE_TOL = 1e-3
 
 @jit
 def _pivot(T, basis, r, j):
-    """Gauss–Jordan pivot of tableau T on (r, j): variable j enters the basis in row r. One
-    rank-one update, not a row expression per row: compiled, each `T[i, :] -= c * T[r, :]`
-    allocated its temporary, a third of a hold search's cost (the same products, the same
-    rounding: a row with T[i, j] = 0 subtracts zeros)."""
+    """Gauss–Jordan pivot of tableau T on (r, j): variable j enters the basis in row r. In place,
+    entry by entry: compiled, each row expression `T[i, :] -= c * T[r, :]` allocated its
+    temporary (a third of a hold search's cost), and the rank-one update that replaced it
+    (`np.outer`) a whole tableau per pivot. The same products and the same rounding; rows with
+    T[i, j] = 0 are skipped rather than subtracting zeros."""
     T[r, :] /= T[r, j]
-    factors = T[:, j].copy()
-    factors[r] = 0.0
-    T -= np.outer(factors, T[r, :])
+    for i in range(T.shape[0]):
+        factor = T[i, j]
+        if i != r and factor != 0.0:
+            for col in range(T.shape[1]):
+                T[i, col] -= factor * T[r, col]
     basis[r] = j
 
 
