@@ -38,12 +38,19 @@ def _resting_row():
     return stacks.ball_row(8, speed=0.0), 1e-3, 100  # 8 loaded floor contacts, 7 pairs apart
 
 
+def _resting_pile():
+    """The 4-row pile at rest: pgs leaves some of its statically indeterminate contacts unloaded
+    ("open", touching); the hold search, which they once started every step (26 allocations a
+    step), has nothing to decide there (two_coefficient.hold_decision_pending)."""
+    return stacks.disk_pile(4), 1e-3, 100
+
+
 @pytest.mark.skipif(not _jit.ENABLED, reason="numba's allocation counters: the compiled loop")
-@pytest.mark.parametrize("case", [_rod, _resting_row])
+@pytest.mark.parametrize("case", [_rod, _resting_row, _resting_pile])
 def test_a_pgs_step_allocates_nothing(case):
     """A run of 2n pgs steps allocates exactly what a run of n steps does — the per-run scratch
     and records, nothing per step — where neither the hold search nor pgs's mode polish runs (they
-    allocate, docs/solvers.md): the paper's rod, a row of balls at rest."""
+    allocate, docs/solvers.md): the paper's rod, a row of balls at rest, a pile at rest."""
     from numba.core.runtime import _nrt_python as nrt_stats, rtsys
 
     (scene, q0, v0), h, steps = case()

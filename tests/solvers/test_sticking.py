@@ -378,3 +378,35 @@ def test_the_split_margin_without_unknowns_is_the_simplex_optimum():
         else:
             assert closed == pytest.approx(x[0] - x[1], rel=1e-12, abs=1e-12)
     assert 0 < infeasible < 300
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_least_squares_without_svd_vouches_only_for_full_rank(compiled):
+    """_full_row_rank_solution (a QR and a triangular inverse in place of LAPACK's SVD, one per LP of
+    the hold search) certifies A's full row rank at RANK_TOL only when the SVD would find it: then
+    x0 is the minimum-norm solution and Z an orthonormal basis of A's null space; a rank-deficient
+    or nearly so A (the SVD's rank below m) is never certified — the caller takes the SVD."""
+    from nonsmooth_rod.solvers import sticking
+    solve = sticking._full_row_rank_solution if compiled else _interpreted(sticking._full_row_rank_solution)
+    rng = np.random.default_rng(3)
+    certified = deficient = 0
+    for trial in range(300):
+        m = int(rng.integers(1, 10))
+        n = int(rng.integers(m, 14))
+        A, b = rng.normal(size=(m, n)), rng.normal(size=m)
+        if trial % 3 == 0 and m > 1:  # a repeated row, up to a perturbation at or below RANK_TOL
+            A[-1] = 2.0 * A[0] + rng.normal(size=n) * 10.0 ** rng.uniform(-18, -10)
+        ok, x0, Z = solve(A, b)
+        s = np.linalg.svd(A, compute_uv=False)
+        if s[-1] <= sticking.RANK_TOL * s[0]:  # the SVD's rank is below m
+            deficient += 1
+            assert not ok
+        if not ok:
+            continue
+        certified += 1
+        x_ref = np.linalg.pinv(A) @ b
+        assert np.max(np.abs(x0 - x_ref)) <= 1e3 * np.finfo(float).eps * (s[0] / s[-1]) * np.max(np.abs(x_ref))
+        assert Z.shape == (n, n - m)
+        np.testing.assert_allclose(Z.T @ Z, np.eye(n - m), atol=1e-13)
+        assert np.max(np.abs(A @ Z), initial=0.0) <= 1e-13 * s[0]
+    assert certified > 150 and deficient > 50  # both kinds occurred

@@ -90,3 +90,65 @@ def test_enum_and_lemke_run_a_scene_of_more_contacts_than_enum_takes_at_once(sol
         t = np.array([math.cos(alpha), math.sin(alpha)])
         accel = np.diff(v[:, 3 * b:3 * b + 2] @ t) / h
         np.testing.assert_allclose(accel, -G * (math.sin(alpha) - 0.3 * math.cos(alpha)), rtol=1e-9)
+
+
+def _hold_pending(u, states, p_zero=True, start_guess=None, resting=None, closing=None):
+    from nonsmooth_rod.solvers.two_coefficient import hold_decision_pending
+    na = states.shape[0]
+    start_guess = np.zeros(na) if start_guess is None else start_guess
+    resting = np.ones(na) if resting is None else resting
+    closing = np.zeros(na) if closing is None else closing
+    return hold_decision_pending(start_guess, resting, 1e-9, closing, np.asarray(u, float), states)
+
+
+def test_a_hold_decision_is_pending_only_when_a_contact_that_was_at_rest_moves():
+    """The hold search can only change the answer when a contact that started at rest slides or
+    lifted off; one that touches without load (open, u = 0: a pile's unloaded pairs) or sticks
+    leaves nothing to decide (sticking._resting_contacts finds no moving candidate)."""
+    from nonsmooth_rod.solvers.two_coefficient import STATE_OPEN
+    stick_and_unloaded = np.array([STATE_STICK, STATE_OPEN], dtype=np.int64)
+    assert not _hold_pending([0.0, 0.0, 0.0, 3e-10], stick_and_unloaded)  # touching, slip below tol
+    assert _hold_pending([0.0, 0.0, 1e-6, 0.0], stick_and_unloaded)  # the unloaded one lifted off
+    assert not _hold_pending([0.0, 0.0, 1e-6, 0.0], stick_and_unloaded, closing=np.array([0.0, 1e-6]))  # closing its gap
+    sliding = np.array([STATE_STICK, STATE_SLIP_PLUS], dtype=np.int64)
+    assert _hold_pending([0.0, 0.0, 0.0, 1e-6], sliding)
+    assert not _hold_pending([0.0, 0.0, 0.0, 1e-6], sliding, start_guess=np.array([0.0, 1.0]))  # was sliding
+    assert not _hold_pending([0.0, 0.0, 0.0, 1e-6], sliding, resting=np.array([1.0, 0.0]))  # was not at rest
+    all_stick = np.array([STATE_STICK, STATE_STICK], dtype=np.int64)
+    assert not _hold_pending([0.0, 0.0, 0.0, 0.0], all_stick)
+
+
+def test_a_pile_at_rest_starts_no_hold_search():
+    """The 4-row pile settles in its first steps, then its unloaded contacts (open, touching, no
+    slip) made the hold search run — its set-up and ~26 allocations — every step for nothing. Run
+    interpreted in a child process (the compiled loop cannot be counted), the search counted:
+    none after the first 20 steps (before: one every step)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = """
+import numpy as np
+import nonsmooth_rod as nr
+from nonsmooth_rod.solvers import two_coefficient as tc
+from nonsmooth_rod.toys import stacks
+steps = []
+search = tc._hold_search
+def counted(*args):
+    steps.append(1)
+    return search(*args)
+tc._hold_search = counted
+scene, q0, v0 = stacks.disk_pile(4)
+early = nr.simulate(scene, q0, v0, 0.02, h=1e-3, solver="pgs", repeat_rest=False)
+settled = len(steps)
+run = nr.simulate(scene, early.q[-1], early.v[-1], 0.06, h=1e-3, solver="pgs", repeat_rest=False)
+print(run.status.value, run.steps, len(steps) - settled, float(np.max(np.abs(run.q - q0))))
+"""
+    src = Path(__file__).resolve().parents[2] / "src"
+    env = dict(os.environ, NONSMOOTH_ROD_NO_JIT="1", PYTHONPATH=str(src))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    status, steps, searches, moved = out.stdout.split()
+    assert status == "ok" and int(steps) == 60
+    assert int(searches) == 0
+    assert float(moved) < 1e-6  # the pile holds: what moved is its first steps' settling

@@ -51,14 +51,17 @@ REUSE_TOL = 1e-3
 
 @jit
 def _pivot(T, basis, r, j):
-    """Gauss–Jordan pivot of tableau T on (r, j): variable j enters the basis in row r. One
-    rank-one update, not a row expression per row: compiled, each `T[i, :] -= c * T[r, :]`
-    allocated its temporary, a third of a hold search's cost (the same products, the same
-    rounding: a row with T[i, j] = 0 subtracts zeros)."""
+    """Gauss–Jordan pivot of tableau T on (r, j): variable j enters the basis in row r. In place,
+    entry by entry: compiled, each row expression `T[i, :] -= c * T[r, :]` allocated its
+    temporary (a third of a hold search's cost), and the rank-one update that replaced it
+    (`np.outer`) a whole tableau per pivot. The same products and the same rounding; rows with
+    T[i, j] = 0 are skipped rather than subtracting zeros."""
     T[r, :] /= T[r, j]
-    factors = T[:, j].copy()
-    factors[r] = 0.0
-    T -= np.outer(factors, T[r, :])
+    for i in range(T.shape[0]):
+        factor = T[i, j]
+        if i != r and factor != 0.0:
+            for col in range(T.shape[1]):
+                T[i, col] -= factor * T[r, col]
     basis[r] = j
 
 
@@ -182,8 +185,68 @@ def _unknowns(mode, sign, mu_d):
 
 
 @jit
+def _frobenius(A):
+    total = 0.0
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            total += A[i, j] * A[i, j]
+    return np.sqrt(total)
+
+
+@jit
+def _upper_inverse(R):
+    """Inverse of the upper-triangular R by back substitution (entries below the diagonal are
+    ignored); a zero pivot gives infinities, which fail the rank certificate."""
+    m = R.shape[0]
+    inv = np.zeros((m, m))
+    for i in range(m):
+        if not R[i, i] != 0.0:  # singular (or NaN): no inverse to form
+            inv[:, :] = np.inf
+            return inv
+    for j in range(m):
+        for i in range(j, -1, -1):
+            total = 1.0 if i == j else 0.0
+            for k in range(i + 1, j + 1):
+                total -= R[i, k] * inv[k, j]
+            inv[i, j] = total / R[i, i]
+    return inv
+
+
+@jit
+def _full_row_rank_solution(A, b):
+    """x0 and Z of _particular_and_null without the SVD, when A (m × n, m ≤ n) certainly has full row
+    rank at RANK_TOL: (True, x0, Z), else (False, ·, ·) and the caller takes the SVD.
+
+    Householder QR (LAPACK's, which never fails) of Aᵀ beside the identity, [Aᵀ | I] = Q [R₁₁ ·; 0 ·]:
+    Aᵀ = Q₁ R₁₁ with Q₁ the first m columns of Q, and the last n − m columns of Q span A's null
+    space (none for a square A: a mode that fixes the split, a row of balls). The certificate:
+    σ_min(R₁₁) ≥ 1/‖R₁₁⁻¹‖_F and σ_max(R₁₁) ≤ ‖R₁₁‖_F, so ‖R₁₁‖_F ‖R₁₁⁻¹‖_F < 1/RANK_TOL means
+    every singular value of A is above RANK_TOL × the largest — the SVD's rank would be m too. Then
+    x0 = Q₁ R₁₁⁻ᵀ b is the SVD's minimum-norm solution to round-off, and Z spans the same null
+    space in another orthonormal basis. A QR and a triangular inverse cost a fraction of LAPACK's
+    SVD, which was 45 % of a row of 16's CPU (one per LP of the hold search)."""
+    m, n = A.shape
+    if m == 0 or m > n:
+        return False, np.zeros(n), np.zeros((n, 0))
+    M = np.zeros((n, m + n))
+    M[:, :m] = A.T
+    for j in range(n):
+        M[j, m + j] = 1.0
+    Q, R = np.linalg.qr(M)
+    R_inv = _upper_inverse(R[:m, :m])
+    if not (_frobenius(R[:m, :m]) * _frobenius(R_inv) < 1.0 / RANK_TOL):
+        return False, np.zeros(n), np.zeros((n, 0))
+    x0 = np.ascontiguousarray(Q[:, :m]) @ (np.ascontiguousarray(R_inv.T) @ b)
+    return True, x0, np.ascontiguousarray(Q[:, m:])
+
+
+@jit
 def _particular_and_null(A, b):
-    """Least-squares x0 of A x = b (minimum norm) and an orthonormal basis Z of the null space of A."""
+    """Least-squares x0 of A x = b (minimum norm) and an orthonormal basis Z of the null space of A
+    (_full_row_rank_solution when it can vouch for A's rank, else the SVD)."""
+    certain, x0, Z = _full_row_rank_solution(A, b)
+    if certain:
+        return x0, Z
     U, s, Vt = np.linalg.svd(A)
     n = A.shape[1]
     rank = 0
@@ -398,6 +461,15 @@ def _modes_for(held_mask, candidates, release, n_candidates, u, states, mode, si
 
 
 @jit
+def _binomial(n, k):
+    """n choose k (n ≤ 62: the candidates' bit mask)."""
+    value = 1
+    for i in range(min(k, n - k)):
+        value = value * (n - i) // (i + 1)
+    return value
+
+
+@jit
 def _popcount(mask):
     count = 0
     while mask:
@@ -544,13 +616,18 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
     """The held set of prefer_sticking as a bit mask over the candidates (mode, sign and p_new
     filled for it), or −1 when none is admissible or the trials run out. Largest first; a size
     with one admissible set returns it; a size with several restricts the search to the subsets of
-    their intersection (strictly smaller), so a tie is never broken by contact order."""
+    their intersection (strictly smaller), so a tie is never broken by contact order. A size whose
+    sets would not all fit in the trials left ends the search at once: it ran out within that size
+    anyway (a size is decided only once all its sets are tried), so the answer is the same −1,
+    without its LPs (the row of 16's wave: 8 candidates kept, 37 trials instead of 64)."""
     allowed = (1 << n_c) - 1
     trials = 0
     p_found = np.empty_like(p_new)
     while True:
         found, n_found, common = -1, 0, allowed
         for size in range(_popcount(allowed), -1, -1):
+            if trials + _binomial(_popcount(allowed), size) > MAX_TRIALS:
+                return -1  # the trials would run out within this size: the same −1, without its LPs
             for held in range(allowed + 1):
                 if held & ~allowed or _popcount(held) != size:
                     continue

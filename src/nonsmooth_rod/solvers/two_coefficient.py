@@ -217,14 +217,33 @@ def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
     already sliding (or grazing a rolling neighbour) keeps the solver's answer: the search costs
     milliseconds on rows of balls and has nothing to hold there. Groups of more than MAX_DENSE_HOLD
     contacts keep the solver's split. p_start: the previous step's impulses (the warm start), or empty."""
-    moving = False
-    for i in range(mu_s.shape[0]):
-        if resting[i] > 0.0 and start_guess[i] == 0.0 and states[i] != STATE_STICK:
-            moving = True
-    if not moving:  # the common step: nothing to search
-        return False
+    if not hold_decision_pending(start_guess, resting, velocity_tol, closing, u, states):
+        return False  # the common step, and a pile at rest with unloaded contacts: nothing to search
     return _hold_search(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
                         states, p_start)
+
+
+@jit_borrowing
+def hold_decision_pending(start_guess, resting, velocity_tol, closing, u, states):
+    """Has the hold search anything to decide? It runs when a contact that started the step at rest
+    does not stick, and it can only change the answer when such a contact moves: slides while
+    touching (|u_T| above the slip tolerance) or lifted off (open, u_N above it, and not merely
+    closing its gap) — sticking.prefer_sticking_from returns the solver's answer otherwise
+    (`_resting_contacts` finds no moving candidate). A contact that touches without load (p = 0,
+    u = 0 within the tolerance: the unloaded pairs of a pile at rest) and every contact that
+    sticks leave nothing to decide: this test, in the step's arrays (allocates nothing), skips
+    the search's set-up then — the same answer, bit for bit."""
+    not_stuck, moving = False, False
+    for i in range(states.shape[0]):
+        if resting[i] <= 0.0 or start_guess[i] != 0.0:
+            continue
+        not_stuck = not_stuck or states[i] != STATE_STICK
+        touching = abs(u[2 * i]) <= velocity_tol or abs(u[2 * i] - closing[i]) <= velocity_tol
+        if touching:
+            moving = moving or abs(u[2 * i + 1]) > velocity_tol
+        else:
+            moving = moving or states[i] == STATE_OPEN
+    return not_stuck and moving
 
 
 @jit
