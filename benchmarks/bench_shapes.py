@@ -8,14 +8,12 @@ A tower of `--boxes` boxes (0.4 × 0.3 m, μs = 0.5, μd = 0.4) on a floor, at r
 compiled Moreau–Jean loop (lemke, h = 1 ms): once with the contacts `find_contacts` lists for
 every pair of shapes (32 candidates per pair of boxes, 4 per box on the floor; the broad phase
 leaves the far pairs out), once with only the contacts that touch declared by hand (each box's
-two bottom corners on the top of the box below, or on the floor), and once with the very
-features the found run keeps declared by hand (at the flush corners of equal boxes the tie goes
-to the lower box's top corners on the upper box's bottom edge, model/collision.py: the same
-physics, one more Lemke pivot a step in 19). Prints CPU µs per step of each (median of --repeat
-runs, the three alternated, after a warm-up run that compiles) and the overhead of finding over
-each declared run, the positions' largest change over the run (the tower holds: zero creep),
-and exits 1 if the runs' trajectories differ by more than round-off. --quick: 400 steps, one
-repeat.
+two bottom corners on the top of the box below, or on the floor: the very contacts, in the
+same order, that the found run keeps at the flush corners, model/collision.py). Prints CPU µs
+per step of each (median of --repeat runs, the two alternated, after a warm-up run that
+compiles) and the overhead of finding, the positions' largest change over the run (the tower
+holds: zero creep), and exits 1 if the two runs' trajectories differ by more than round-off.
+--quick: 400 steps, one repeat.
 
 --peers: the tower of 5 boxes at rest (1000 steps), the row of 20 dominoes toppling
 (toys.Dominoes, pushed at 1.1 J*, 2500 steps) and a heap of 50 boxes dropped into a bin
@@ -49,10 +47,8 @@ import planar_peers  # noqa: E402
 W, H = 0.4, 0.3
 
 
-def tower(n: int, found: bool, found_features: bool = False):
-    """(scene, q0) of a tower of n boxes, with found or hand-declared contacts (found_features:
-    declared on the features find_contacts keeps, each lower box's top corners, left to right,
-    on the upper box's bottom edge)."""
+def tower(n: int, found: bool):
+    """(scene, q0) of a tower of n boxes, with found or hand-declared contacts."""
     bodies = [nr.RigidBody(1.0, (W * W + H * H) / 12.0, name=f"box{k}") for k in range(n)]
     law, floor, box = nr.ContactLaw.of(0.5, 0.4), nr.Line(), nr.Polygon.rectangle(W, H)
     if found:
@@ -60,13 +56,9 @@ def tower(n: int, found: bool, found_features: bool = False):
     else:
         contacts = [nr.PointOnLine(0, box.vertices[i], floor, law, name=f"box0.v{i}/floor") for i in (0, 1)]
         for k in range(1, n):
-            for i in ((3, 2) if found_features else (0, 1)):
-                if found_features:
-                    contacts.append(nr.VertexOnEdge(k - 1, box.vertices[i], k, *box.edge(0), cone=box.cone(i),
-                                                    law=law, name=f"box{k - 1}.v{i}/box{k}.e0"))
-                else:
-                    contacts.append(nr.VertexOnEdge(k, box.vertices[i], k - 1, *box.edge(2), cone=box.cone(i),
-                                                    law=law, name=f"box{k}.v{i}/box{k - 1}.e2"))
+            for i in (0, 1):
+                contacts.append(nr.VertexOnEdge(k, box.vertices[i], k - 1, *box.edge(2), cone=box.cone(i), law=law,
+                                                name=f"box{k}.v{i}/box{k - 1}.e2"))
     q0 = np.zeros(3 * n)
     q0[1::3] = H / 2 + H * np.arange(n)
     return nr.Scene(bodies, contacts), q0
@@ -138,24 +130,21 @@ def main(argv=None) -> int:
         peers_table(args.quick, 1 if args.quick else args.repeat)
         return 0
     steps, repeat = (400, 1) if args.quick else (args.steps, args.repeat)
-    cases = {"declared": tower(args.boxes, False), "declared, found's features": tower(args.boxes, False, True),
-             "found": tower(args.boxes, True)}
+    cases = {"declared": tower(args.boxes, False), "found": tower(args.boxes, True)}
     for scene, q0 in cases.values():
         nr.simulate(scene, q0, np.zeros_like(q0), 0.01, "moreau-jean", h=1e-3)  # compile, warm
     costs, results = {name: [] for name in cases}, {}
-    for _ in range(repeat):  # alternated: the three see the same load
+    for _ in range(repeat):  # alternated: the two see the same load
         for name, (scene, q0) in cases.items():
             us, results[name] = _timed(scene, q0, steps)
             costs[name].append(us)
     us = {name: statistics.median(c) for name, c in costs.items()}
     for name, (scene, q0) in cases.items():
         creep = float(np.abs(results[name].trajectory.q - q0).max())
-        print(f"{name:27s} {len(scene.contacts):4d} contacts  {us[name]:8.2f} µs/step  creep {creep:.1e} m")
-    for name in ("declared", "declared, found's features"):
-        print(f"finding the contacts costs {100 * (us['found'] / us[name] - 1.0):+.1f} % per step over {name} "
-              f"({args.boxes} boxes, {steps} steps, CPU time, median of {repeat})")
-    q_found = results["found"].trajectory.q
-    same = all(np.allclose(q_found, results[name].trajectory.q, rtol=0, atol=1e-12) for name in cases)
+        print(f"{name:8s}  {len(scene.contacts):4d} contacts  {us[name]:8.2f} µs/step  creep {creep:.1e} m")
+    print(f"finding the contacts costs {100 * (us['found'] / us['declared'] - 1.0):+.1f} % per step "
+          f"({args.boxes} boxes, {steps} steps, CPU time, median of {repeat})")
+    same = np.allclose(results["found"].trajectory.q, results["declared"].trajectory.q, rtol=0, atol=1e-12)
     if not same:
         print("the found and the declared runs differ", file=sys.stderr)
     return 0 if same else 1
