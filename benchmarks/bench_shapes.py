@@ -1,17 +1,19 @@
 """The cost of contacts found from shapes against the same contacts declared by hand, and the
 box scenes beside pymunk and MuJoCo.
 
-    python benchmarks/bench_shapes.py [--boxes 5] [--steps 20000] [--repeat 3] [--quick]
+    python benchmarks/bench_shapes.py [--boxes 5] [--steps 20000] [--repeat 5] [--quick]
     python benchmarks/bench_shapes.py --peers [--repeat 3] [--quick]
 
 A tower of `--boxes` boxes (0.4 × 0.3 m, μs = 0.5, μd = 0.4) on a floor, at rest, run by the
 compiled Moreau–Jean loop (lemke, h = 1 ms): once with the contacts `find_contacts` lists for
 every pair of shapes (32 candidates per pair of boxes, 4 per box on the floor; the broad phase
 leaves the far pairs out), once with only the contacts that touch declared by hand (each box's
-two bottom corners on the top of the box below, or on the floor). Prints µs per step of each
-(best of --repeat runs, after a warm-up run that compiles) and the overhead of finding, the
-positions' largest change over the run (the tower holds: zero creep), and exits 1 if the two
-runs' trajectories differ by more than round-off. --quick: 400 steps, one repeat.
+two bottom corners on the top of the box below, or on the floor: the very contacts, in the
+same order, that the found run keeps at the flush corners, model/collision.py). Prints CPU µs
+per step of each (median of --repeat runs, the two alternated, after a warm-up run that
+compiles) and the overhead of finding, the positions' largest change over the run (the tower
+holds: zero creep), and exits 1 if the two runs' trajectories differ by more than round-off.
+--quick: 400 steps, one repeat.
 
 --peers: the tower of 5 boxes at rest (1000 steps), the row of 20 dominoes toppling
 (toys.Dominoes, pushed at 1.1 J*, 2500 steps) and a heap of 50 boxes dropped into a bin
@@ -62,13 +64,12 @@ def tower(n: int, found: bool):
     return nr.Scene(bodies, contacts), q0
 
 
-def _timed(scene, q0, steps: int, repeat: int):
-    best, result = np.inf, None
-    for _ in range(repeat):
-        started = time.perf_counter()
-        result = nr.simulate(scene, q0, np.zeros_like(q0), steps * 1e-3, "moreau-jean", h=1e-3, save_every=0.1)
-        best = min(best, time.perf_counter() - started)
-    return best / steps * 1e6, result
+def _timed(scene, q0, steps: int):
+    """(CPU µs per step, result) of one run: CPU time, which the other processes of a loaded
+    machine disturb far less than the wall clock."""
+    started = time.process_time()
+    result = nr.simulate(scene, q0, np.zeros_like(q0), steps * 1e-3, "moreau-jean", h=1e-3, save_every=0.1)
+    return (time.process_time() - started) / steps * 1e6, result
 
 
 def peer_scenes(quick: bool):
@@ -121,7 +122,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--boxes", type=int, default=5)
     parser.add_argument("--steps", type=int, default=20000)
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--peers", action="store_true")
     args = parser.parse_args(argv)
@@ -129,17 +130,21 @@ def main(argv=None) -> int:
         peers_table(args.quick, 1 if args.quick else args.repeat)
         return 0
     steps, repeat = (400, 1) if args.quick else (args.steps, args.repeat)
-    rows = {}
-    for found in (False, True):
-        scene, q0 = tower(args.boxes, found)
+    cases = {"declared": tower(args.boxes, False), "found": tower(args.boxes, True)}
+    for scene, q0 in cases.values():
         nr.simulate(scene, q0, np.zeros_like(q0), 0.01, "moreau-jean", h=1e-3)  # compile, warm
-        rows[found] = (len(scene.contacts), *_timed(scene, q0, steps, repeat), q0)
-    for found, (nc, us, result, q0) in rows.items():
-        creep = float(np.abs(result.trajectory.q - q0).max())
-        print(f"{'found   ' if found else 'declared'}  {nc:4d} contacts  {us:8.2f} µs/step  creep {creep:.1e} m")
-    overhead = rows[True][1] / rows[False][1] - 1.0
-    print(f"finding the contacts costs {100 * overhead:+.1f} % per step ({args.boxes} boxes, {steps} steps)")
-    same = np.allclose(rows[True][2].trajectory.q, rows[False][2].trajectory.q, rtol=0, atol=1e-12)
+    costs, results = {name: [] for name in cases}, {}
+    for _ in range(repeat):  # alternated: the two see the same load
+        for name, (scene, q0) in cases.items():
+            us, results[name] = _timed(scene, q0, steps)
+            costs[name].append(us)
+    us = {name: statistics.median(c) for name, c in costs.items()}
+    for name, (scene, q0) in cases.items():
+        creep = float(np.abs(results[name].trajectory.q - q0).max())
+        print(f"{name:8s}  {len(scene.contacts):4d} contacts  {us[name]:8.2f} µs/step  creep {creep:.1e} m")
+    print(f"finding the contacts costs {100 * (us['found'] / us['declared'] - 1.0):+.1f} % per step "
+          f"({args.boxes} boxes, {steps} steps, CPU time, median of {repeat})")
+    same = np.allclose(results["found"].trajectory.q, results["declared"].trajectory.q, rtol=0, atol=1e-12)
     if not same:
         print("the found and the declared runs differ", file=sys.stderr)
     return 0 if same else 1

@@ -24,8 +24,11 @@ with several), `.a`, `.b` (a segment's ends), `.side+`, `.side-` (a segment's si
 points to, or the other) — e.g. `box1.v2/box2.e0`, `ball/table`, `table.b/box.e0`.
 The names are stable: a contact keeps its name (and its column in the outputs) while the same
 features touch. At a corner exactly on a corner the two mirror pairs (vertex of a on edge of
-b, vertex of b on edge of a) give the same touch: the pair whose vertex belongs to the shape
-listed first (bodies before obstacles) keeps it.
+b, vertex of b on edge of a) give the same touch: between two bodies, the pair whose vertex
+belongs to the body listed later keeps it (a box on the box below it, a tower listed from the
+floor up: its bottom corners on the top below, as a hand-written scene declares them — the
+same contacts in the same order, so the same Lemke pivots); between a body and an obstacle, the
+body's vertex.
 
 Each candidate is one contact of the scene (a column of trajectory.csv, ~25 floats of memory
 per kept sample): a box–box pair is 32 candidates, a box on a line 4. Filter pairs that cannot
@@ -189,13 +192,17 @@ def polygon_pair_contacts(poly_a, body_a, name_a, poly_b, body_b, name_b, law, t
     corner exactly on a corner, the first polygon's vertices keep the tie when tie_to_first."""
     depth = DEPTH_FRACTION * min(poly_a.width, poly_b.width)
     found = []
-    for (pv, bv, nv, pe, be, ne, wins) in ((poly_a, body_a, name_a, poly_b, body_b, name_b, tie_to_first),
-                                           (poly_b, body_b, name_b, poly_a, body_a, name_a, not tie_to_first)):
-        # Edge by edge, each edge's vertices of the other polygon from the last: two faces that
-        # touch give their corners in the edge's direction (a CCW outline runs the other way on
-        # the facing side), the order a hand-written scene lists them (Lemke's pivots follow it).
+    for (pv, bv, nv, pe, be, ne, wins, order) in (
+            (poly_a, body_a, name_a, poly_b, body_b, name_b, tie_to_first, -1),
+            (poly_b, body_b, name_b, poly_a, body_a, name_a, not tie_to_first, 1)):
+        # Edge by edge, each edge's vertices of the other polygon: a's from the last, b's from the
+        # first. Two faces that touch then give their corners in one direction whichever polygon's
+        # corners they are (a CCW outline runs the other way on the facing side): a body listed
+        # above the one below it (a tower from the floor up) gives them left to right, as a
+        # hand-written scene lists them — Lemke's pivots follow the order (a tower of 5 boxes:
+        # 18.7 a step left to right, 25.9 right to left).
         for k in range(len(pe.vertices)):
-            for i in reversed(range(len(pv.vertices))):
+            for i in range(len(pv.vertices))[::order]:
                 vertex = pv.vertices[i]
                 found.append(VertexOnEdge(bv, vertex, be, *pe.edge(k), cone=pv.cone(i), tie_wins=wins,
                                           depth_limit=depth, law=law, name=f"{nv}.v{i}/{ne}.e{k}",
@@ -257,7 +264,8 @@ def _pair(a, b, law):
         return []
     if isinstance(sa, Polygon):
         if isinstance(sb, Polygon):
-            return _keyed(polygon_pair_contacts(sa, ba, na, sb, bb, nb, law))
+            # corners on corners: the later body's (a box on the one below it, listed before it)
+            return _keyed(polygon_pair_contacts(sa, ba, na, sb, bb, nb, law, tie_to_first=False))
         if isinstance(sb, Disk):
             return _keyed(_disk_polygon(sb, bb, nb, sa, ba, na, law))
         if isinstance(sb, Line):
