@@ -7,6 +7,11 @@ wait for it); tests/engine/test_compile_policy.py checks the default policy in i
 On a cold cache the suite starts both compiled loops (whole-run and step-wise) in detached
 processes at once, so the tests that need no compiled engine run while they compile, and a test
 that needs one waits only for what is left.
+
+Which tests run first: the files marked `no_compiled_loop` (they never run the compiled
+Moreau–Jean loop in-process — event-driven, solvers, validation, the fits — so they keep both
+workers busy while the loop compiles), then the others, each group largest file first (xdist's own
+balancing). The mark is checked: a marked test that enters the compiled loop fails, naming itself.
 """
 import os
 
@@ -14,6 +19,8 @@ os.environ.setdefault("NONSMOOTH_ROD_COMPILE", "wait")
 
 
 def pytest_configure(config):
+    if hasattr(config.option, "loadscopereorder"):  # pytest-xdist ≥ 3.8: keep the order set below
+        config.option.loadscopereorder = False
     if hasattr(config, "workerinput"):  # an xdist worker: the controller started the compiles
         return
     from nonsmooth_rod import _jit
@@ -26,6 +33,30 @@ def pytest_configure(config):
 
 
 import pytest  # noqa: E402
+
+
+def pytest_collection_modifyitems(config, items):
+    """Files marked no_compiled_loop first, then the rest; within each, the files with more tests first."""
+    files = {}
+    for item in items:
+        files.setdefault(item.path, []).append(item)
+    order = sorted(files.values(), key=lambda tests: (tests[0].get_closest_marker("no_compiled_loop") is None,
+                                                      -len(tests)))
+    items[:] = [item for tests in order for item in tests]
+
+
+@pytest.fixture(autouse=True)
+def _no_compiled_loop_is_true(request, monkeypatch):
+    """A test marked no_compiled_loop fails if it enters the compiled loop (it would wait for the
+    compile the mark promises it does not need)."""
+    if request.node.get_closest_marker("no_compiled_loop") is None:
+        return
+    from nonsmooth_rod import _jit
+
+    def refuse(part, what):
+        pytest.fail(f"{request.node.nodeid} is marked no_compiled_loop but runs {what}: remove its mark")
+
+    monkeypatch.setattr(_jit, "compiling", refuse)
 
 
 @pytest.fixture

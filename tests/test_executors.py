@@ -14,6 +14,8 @@ import pytest
 from nonsmooth_rod.executors import open_executor
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 
 

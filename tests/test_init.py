@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 ROOT = Path(__file__).resolve().parents[1]
 # What a plain import must not load: numba (and llvmlite, yaml and scipy, which numba imports),
 # plotting, tables, sweeps' executors, the CLI's colours.

@@ -13,6 +13,8 @@ from nonsmooth_rod.cli import main
 from nonsmooth_rod.scenefile import load_scene
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "scenes"
 BALL = (EXAMPLES / "bouncing_ball.toml").read_text()
 

@@ -21,6 +21,8 @@ from nonsmooth_rod.validation import (
     require_state,
 )
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 @pytest.mark.parametrize("value, fragment", [
     ("1e-3", "must be a number, got '1e-3'"),  # a string is not a number, even one that reads as one

@@ -4,6 +4,8 @@ import pytest
 
 from nonsmooth_rod.cli import main
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 SIMULATE = [
     (["--length", "1e308"], "--length"),
     (["--mass", "1e308", "--xi", "0.2", "--inertia", "0.02"], "--mass"),

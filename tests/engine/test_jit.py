@@ -1,7 +1,11 @@
 """The compile cache goes somewhere writable, and NUMBA_CACHE_DIR always wins."""
 import os
 
+import pytest
+
 from nonsmooth_rod import _jit
+
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
 
 
 def _unset_cache_dir(monkeypatch):

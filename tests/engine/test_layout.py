@@ -7,6 +7,8 @@ import pytest
 
 import nonsmooth_rod as nr
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 PACKAGE = Path(nr.__file__).resolve().parent
 PUBLIC = ["simulate", "Scene", "RigidBody", "Line", "DiskOnLine", "PointOnLine", "DiskOnDisk", "ContactLaw",
           "solve", "SimulationResult", "Status", "ContactState", "StopAtImpact", "InputError"]

@@ -16,6 +16,8 @@ from nonsmooth_rod.integrators.declaration import NO_JOINTS, Declaration, Refusa
 from nonsmooth_rod.integrators.sampling import Thinning, stop_message
 from nonsmooth_rod.results import SimulationResult, Trajectory
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 G = 9.81
 
 

@@ -8,6 +8,8 @@ from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.rod.hypotheses import rolling_hypothesis, sliding_hypothesis
 from nonsmooth_rod.rod.simulation import scenario, simulate
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def modes(run):
     return [ph.mode for ph in run.phases]

@@ -17,6 +17,8 @@ from nonsmooth_rod.model.contact_kernels import SEAM_TOL
 from nonsmooth_rod.scenefile import load_scene, simulate_scene
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 R, M, G = 0.1, 1.0, 9.81
 TABLE = nr.Segment((-1.0, 0.0), (0.0, 0.0), name="table")
 SCENES = Path(__file__).resolve().parents[2] / "examples" / "scenes"

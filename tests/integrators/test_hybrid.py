@@ -17,6 +17,8 @@ from nonsmooth_rod.rod.simulation import simulate as simulate_rod
 from nonsmooth_rod.toys.bouncing_ball import BouncingBall
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 ROLLING_UNTIL = 0.09  # s: case 2 sticks (rolls) until 0.1041 s
 
 

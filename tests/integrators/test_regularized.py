@@ -21,6 +21,8 @@ from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.rod.simulation import simulate
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def test_friction_curves_have_their_documented_shape():
     eps, mu_s, mu_d = 1e-3, 0.28, 0.20

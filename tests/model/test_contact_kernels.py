@@ -15,6 +15,8 @@ from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.packing import contact_kinematics, pack_contacts
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 EPS = 1e-6  # finite-difference step (s); the central difference errs by ~EPS² × third derivative
 
 

@@ -19,6 +19,8 @@ from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
 from nonsmooth_rod.rod.problem import RodProblem
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 MODES = ("open", "stick", "slip+", "slip-")
 
 

@@ -9,6 +9,8 @@ import nonsmooth_rod as nr
 from nonsmooth_rod.model.joints import ROWS_PER_JOINT, joint_rows, joint_violation, pack_joints
 from nonsmooth_rod.solvers._common import interpreted
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def _rows(joints, q):
     table = pack_joints(joints, len(q) // 3)

@@ -9,6 +9,8 @@ from nonsmooth_rod.model.dynamics import mode_dynamics
 from nonsmooth_rod.rod.problem import RodGeometry, RodProblem
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def test_paper_mass_properties_to_the_papers_digits():
     mass, xi, inertia = RodGeometry().inertial_properties()

@@ -8,6 +8,8 @@ from nonsmooth_rod.rod.problem import RodProblem
 from nonsmooth_rod.rod.simulation import simulate
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 # Event-driven reference (rtol 1e-12).
 REF = {1: (0.336957, [("slip-", 0.328527), ("slip+", 0.336957)]),
        2: (0.375302, [("stick", 0.104101), ("slip-", 0.302348), ("slip+", 0.375302)]),

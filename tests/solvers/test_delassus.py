@@ -3,8 +3,11 @@ dense W, a group's dense W from either form, and the coupled groups from either 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from nonsmooth_rod.solvers.delassus import coupled_components, dense_to_blocks, group_matrix
+
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
 
 EMPTY = np.zeros(0, dtype=np.int64)
 NO_BLOCKS = np.zeros((0, 2, 2))

@@ -7,6 +7,8 @@ import pytest
 from nonsmooth_rod.solvers import lcp
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 @pytest.mark.parametrize("M, q, z_exact", [
     # symmetric positive definite: both unknowns active, M z = −q

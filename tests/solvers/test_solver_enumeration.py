@@ -15,6 +15,8 @@ from nonsmooth_rod.solvers.problem import (
 )
 from solver_cases import block_on_incline, friction_steps
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def close(a, b, rtol=1e-8):
     return np.abs(a - b).max() <= rtol * max(1.0, np.abs(a).max(), np.abs(b).max())

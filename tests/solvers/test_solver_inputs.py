@@ -12,6 +12,8 @@ from nonsmooth_rod.solvers.problem import PlanarFrictionProblem
 from nonsmooth_rod.validation import InputError
 from solver_cases import block_on_incline
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def corrupted(argument, bad):
     problem = block_on_incline(0.3, 0.5)

@@ -22,6 +22,8 @@ from nonsmooth_rod.solvers.lemke import HAVE_NUMBA, lemke_friction
 from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity_residual, residual_scale
 from solver_cases import block_on_incline, friction_steps, random_step
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 SOLVER_CODES = [SOLVER_LEMKE, SOLVER_PGS, SOLVER_ENUM]
 
 

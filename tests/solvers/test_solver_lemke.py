@@ -20,6 +20,8 @@ from nonsmooth_rod.solvers.problem import (
 )
 from solver_cases import block_on_incline, friction_steps, random_step
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 JIT_MODES = [False, True] if HAVE_NUMBA else [False]
 TOL = 1e-10
 

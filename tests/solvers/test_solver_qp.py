@@ -15,6 +15,8 @@ from nonsmooth_rod.solvers.problem import (
 )
 from solver_cases import finite, friction_steps
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 pytest.importorskip("qpsolvers")
 
 QP_BACKENDS = [name for name in ("osqp", "clarabel") if name in available_solvers()]

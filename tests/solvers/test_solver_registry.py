@@ -17,6 +17,8 @@ from nonsmooth_rod.solvers.problem import (
 )
 from solver_cases import block_on_incline, friction_steps
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 
 def test_available_solvers_lists_exact_then_qp_backends():
     names = available_solvers()

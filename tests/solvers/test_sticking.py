@@ -9,6 +9,8 @@ from nonsmooth_rod.solvers.sticking import (STATE_OPEN, STATE_SLIP_MINUS, STATE_
                                             simplex_max)
 from nonsmooth_rod.toys import WedgedRod
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 H = 1e-3
 
 

@@ -16,6 +16,8 @@ from nonsmooth_rod.studies.maps import scene_data
 from nonsmooth_rod.studies.measurements import Measurements
 from scripts import load_script
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "examples" / "scenes"
 ROD = SCENES / "paper_rod.toml"

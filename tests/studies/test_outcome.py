@@ -5,9 +5,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from nonsmooth_rod.results import Impact, Phase, SimulationResult, Trajectory
 from nonsmooth_rod.studies.outcome import contact_events, held, outcome_row, regime_of
+
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
 
 
 def _result(phases, impacts=(), status="stopped"):

@@ -9,6 +9,8 @@ import pytest
 from nonsmooth_rod.studies.paths import apply_sets, check_path, current_value, with_values
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 DATA = {"schema": "x", "gravity": 9.81,
         "contacts": [{"name": "left", "law": {"mu_s": 0.6, "mu_d": 0.4}},
                      {"name": "right", "law": {"mu_s": 0.6, "mu_d": 0.4}}],

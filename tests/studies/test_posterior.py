@@ -12,6 +12,8 @@ from nonsmooth_rod.studies.measurements import Measurements
 from nonsmooth_rod.validation import InputError
 from scripts import load_script
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

@@ -7,6 +7,8 @@ from nonsmooth_rod import toys
 from nonsmooth_rod.toys import stacks
 from nonsmooth_rod.validation import InputError
 
+pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
+
 BAD = [
     (lambda: toys.BouncingBall(restitution=1.0), "restitution"),  # e = 1 never comes to rest
     (lambda: toys.BlockOnIncline(mu_s=0.2, mu_d=0.3), "mu_d = 0.3 exceeds mu_s = 0.2"),
