@@ -68,10 +68,14 @@ def main(argv=None) -> int:
         seconds = sum(warm_up_python_step(solver) for solver in solvers)
         print(f"compiled the step kernels around {', '.join(solvers)} in {seconds:.1f} s", flush=True)
         return 0
-    try:
-        os.nice(5)  # the user's interpreted run goes first on a busy machine
-    except (AttributeError, OSError):
-        pass
+    if (os.cpu_count() or 1) < 2:
+        # one core: the user's interpreted run goes first. With two or more the run and the compile
+        # each have a core, and a niced compile would only finish later — every run after waits for
+        # it (on a fresh install the test suite's two workers sat idle behind a niced compile)
+        try:
+            os.nice(5)
+        except (AttributeError, OSError):
+            pass
     seconds = warm_up()
     print(f"compiled the Moreau–Jean loop in {seconds:.1f} s", flush=True)
     return 0
