@@ -30,6 +30,7 @@ from .._jit import jit, jit_borrowing
 from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fits_scratch, fitting_scratch,
                       lemke_interval, pgs_block_into, solve_interval_into, solver_floats, solver_ints)
 from .gauss_seidel import PGS_FLOATS
+from .one_contact import one_contact_into
 from ._common import interpreted
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
                       PlanarFrictionProblem, SolverError)
@@ -193,7 +194,11 @@ def _defaults(rtol, max_iter):
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     """solve_interval_into on the dense W, or pgs_or_lemke_into when the block-sparse W is given
     (indptr), in the scratch floats, ints. Returns (status, iterations, residual, 1 if pgs fell back
-    to Lemke else 0)."""
+    to Lemke else 0). A group of one contact whose answer is unique takes it in closed form
+    (one_contact.py: every exact solver's answer, without Lemke's tableau): 0 iterations."""
+    residual = one_contact_into(W, blocks, q, lo, hi, p, u)
+    if residual >= 0.0:
+        return KERNEL_SOLVED, 0, residual, 0
     if indptr.shape[0] > 0:
         return pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter),
                                  floats, ints)
