@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import solvers as _solvers
-from .._jit import jit, jit_borrowing
+from .._jit import jit, jit_borrowing, jit_inline
 # The solver call point: the compiled kernels (registry.SOLVERS with a code); the QP solvers stay
 # Python (solve_two_coefficient below).
 from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fits_scratch, fitting_scratch,
@@ -59,7 +59,7 @@ class StepContactResult:
     consistent: bool
 
 
-@jit_borrowing
+@jit_inline
 def classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
     """States of a step solution under slip guess `guess`; True when the guess is consistent.
 
@@ -125,7 +125,7 @@ def next_action(new_guess, tried, n_tried):
     return NEXT_STOP if _seen(tried, n_tried, new_guess) else NEXT_TRY_ZERO
 
 
-@jit_borrowing
+@jit_inline
 def _interval_of(mu_s, mu_d, guess, lo, hi):
     """The friction interval [c − μs, c + μs], c = (μs − μd) s, of slip guess s."""
     for j in range(guess.shape[0]):
@@ -190,7 +190,7 @@ def _defaults(rtol, max_iter):
     return rtol <= 0.0 and max_iter <= 0
 
 
-@jit_borrowing
+@jit_inline
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     """solve_interval_into on the dense W, or pgs_or_lemke_into when the block-sparse W is given
     (indptr), in the scratch floats, ints. Returns (status, iterations, residual, 1 if pgs fell back
@@ -212,7 +212,7 @@ def _guess_of_states(states, guess):
         guess[i] = 1.0 if states[i] == STATE_SLIP_PLUS else (-1.0 if states[i] == STATE_SLIP_MINUS else 0.0)
 
 
-@jit_borrowing
+@jit_inline
 def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
                  states, p_start):
     """Hold what μs can hold (sticking.prefer_sticking, group by group of coupled contacts) when a
@@ -319,7 +319,7 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
 GROUP_MIN_CONTACTS = 4
 
 
-@jit_borrowing
+@jit_inline
 def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states,
                              floats, ints):
     """two_coefficient_into on a dense W one group of coupled contacts at a time: W is
