@@ -16,7 +16,10 @@ tuples: `Model` (the packed scene, built by `_model_and_work` in moreau_jean.py)
 contacts' memory and the step's kinematics), `Records` (the run's rows, `new_records`; the run goes
 in windows of rows, moreau_jean_records.Window) and `Scratch` (the step's temporaries, allocated once
 per call of the loop, so that a step allocates nothing). `_run` unpacks them once; the step's
-functions take the arrays they use and count no references (`_jit.jit_borrowing`).
+functions take the arrays they use and count no references (`_jit.jit_borrowing`), and the step
+itself (step_arrays and the step functions it calls once) is inlined into run_arrays
+(`_jit.jit_inline`): a call passes each array as ~8 words on the stack, and those pushes were
+most of a one-contact step (docs/performance.md).
 """
 from __future__ import annotations
 
@@ -843,8 +846,8 @@ def step_impulses(na, s_floats, s_states):
 @_inlined
 def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
     """One whole step with generalised force f on the named data (Model, Work, Records, Scratch);
-    returns a run status (the solver read from its code at run time). Compiled without reference
-    counting, the tuples cost nothing to pass: each function below takes the arrays it uses."""
+    returns a run status (the solver read from its code at run time). Inlined into run_arrays, as
+    are begin_arrays, solve_arrays and finish_arrays: no call passes the tuples' arrays."""
     m, w, o = model, work, out
     qk, vk = o.q[k], o.v[k]
     if m.motions.shape[0] > 0:  # (a scene without driven obstacles or bodies skips their calls)
