@@ -119,3 +119,16 @@ def test_shipped_scenes_one_contact_problems_get_lemkes_answer():
             scale = max(np.max(np.abs(q)), np.max(np.abs(reference.p)), 1e-300)
             np.testing.assert_allclose([p_n, p_t], reference.p, rtol=0, atol=1e-12 * scale, err_msg=name)
     assert taken > 100
+
+
+@pytest.mark.parametrize("solver", ["lemke", "pgs"])
+def test_the_step_takes_the_closed_form_for_one_contact(solver):
+    """A disk rolling down an incline (one contact, every step solved): no step reaches the
+    solver, which would count its pivots or sweeps (its physics: tests/toys/test_incline.py)."""
+    import nonsmooth_rod as nr
+    from nonsmooth_rod import toys
+
+    toy = toys.DiskOnIncline()
+    run = nr.simulate(toy.scene(), *toy.initial_state(), 0.2, method="moreau-jean", h=1e-3, solver=solver)
+    assert run.status == "ok" and run.stats["solves"] >= 200
+    assert run.stats["solver_iterations"] == 0
