@@ -16,7 +16,10 @@ tuples: `Model` (the packed scene, built by `_model_and_work` in moreau_jean.py)
 contacts' memory and the step's kinematics), `Records` (the run's rows, `new_records`; the run goes
 in windows of rows, moreau_jean_records.Window) and `Scratch` (the step's temporaries, allocated once
 per call of the loop, so that a step allocates nothing). `_run` unpacks them once; the step's
-functions take the arrays they use and count no references (`_jit.jit_borrowing`).
+functions take the arrays they use and count no references (`_jit.jit_borrowing`), and the step
+itself (step_arrays and the step functions it calls once) is inlined into run_arrays
+(`_jit.jit_inline`): a call passes each array as ~8 words on the stack, and those pushes were
+most of a one-contact step (docs/performance.md).
 """
 from __future__ import annotations
 
@@ -344,7 +347,7 @@ def begin_step(params, qk, vk, f, model, work):
                         work.a_free, work.candidate, np.empty(0))
 
 
-@jit_borrowing
+@_inlined
 def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_keys, pair_contact, joints,
                  joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate, room):
     """Free velocity, contact kinematics and the active set; returns na (< 0: geometry_failure's
@@ -510,7 +513,7 @@ def assemble(params, na, qk, vk, model, work, W, q_step, guess, mu_s, mu_d, clos
                     work.slip_sign, work.v_free, W, q_step, guess, mu_s, mu_d, closing, resting)
 
 
-@jit_borrowing
+@_inlined
 def assemble_arrays(params, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht, active, was_closed,
                     grazing, slip_sign, v_free, W, q_step, guess, mu_s, mu_d, closing, resting):
     """The step problem u = W p + q_step over the active contacts, with slip guesses and μs, μd;
@@ -604,9 +607,7 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     return finish_arrays(k, params, iparams, na, p, u, states, qk, vk, model.minv, model.contacts,
                          model.contact_index, model.pair_keys, model.joints, work.joint_buffer, work.gaps,
                          work.drifts, work.hn, work.ht, work.active, work.was_closed, work.grazing, work.slip_sign,
-                         work.v_free, work.a_free, work.candidate, out.q, out.v, out.p_normal, out.p_tangent,
-                         out.slip, out.states, out.impact_t, out.impact_step, out.impact_contact, out.counters,
-                         out.joint_impulse)
+                         work.v_free, work.a_free, work.candidate, out)
 
 
 @_inlined
@@ -624,13 +625,14 @@ def _end_velocity(na, p, minv, index, hn, ht, active, v_free, v_next):
                                                                   + ht[i, 3 * side + d] * p[2 * a + 1])
 
 
-@jit_borrowing
+@_inlined
 def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, index, pair_keys, joints, joint_buffer,
-                  gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, q, v,
-                  p_normal, p_tangent, slip, state_rec, impact_t, impact_step, impact_contact, counters,
-                  joint_impulse):
-    """End-of-step state, the step's records, impacts and the contacts' memory; returns a run
-    status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
+                  gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, out):
+    """End-of-step state, the step's records (`out`: Records), impacts and the contacts' memory;
+    returns a run status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
+    q, v, p_normal, p_tangent, slip, state_rec = out.q, out.v, out.p_normal, out.p_tangent, out.slip, out.states
+    impact_t, impact_step, impact_contact = out.impact_t, out.impact_step, out.impact_contact
+    counters, joint_impulse = out.counters, out.joint_impulse
     h, theta = params[P_H], params[P_THETA]
     t = step_time(params, k)
     v_next = v[k + 1]
@@ -790,13 +792,15 @@ def _dense_fits(solver_code, na, joints, scratch_w):
     return sparse or 4 * na * na <= scratch_w.shape[0]
 
 
-@jit_borrowing
+@_inlined
 def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht,
-                 active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, s_floats, s_w,
-                 s_solver_floats, s_solver_ints, s_sparse_ints, s_sparse_floats, p, u, states):
+                 active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, scratch, p, u, states):
     """assemble + the two-coefficient kernel into p, u, states (step_impulses' views), in the
-    per-run scratch (s_*: Scratch's arrays); p_normal, p_tangent: the records (the warm start).
+    per-run scratch (Scratch); p_normal, p_tangent: the records (the warm start).
     Returns the kernel status. Borrowing: it allocates nothing (the dense W fits: step_arrays)."""
+    s_floats, s_w = scratch.floats, scratch.W
+    s_sparse_ints, s_sparse_floats = scratch.sparse_ints, scratch.sparse_floats
+    s_solver_floats, s_solver_ints = scratch.solver_floats, scratch.solver_ints
     m = 2 * na
     # pgs sweeps the block-sparse W; lemke, enum need it dense, and so do joints (W_c couples a cluster)
     sparse = takes_block_sparse(solver_code) and joints.shape[0] == 0
@@ -839,11 +843,11 @@ def step_impulses(na, s_floats, s_states):
     return s_floats[7 * na: 9 * na], s_floats[9 * na: 11 * na], s_states[:na]
 
 
-@jit_borrowing
+@_inlined
 def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
     """One whole step with generalised force f on the named data (Model, Work, Records, Scratch);
-    returns a run status (the solver read from its code at run time). Compiled without reference
-    counting, the tuples cost nothing to pass: each function below takes the arrays it uses."""
+    returns a run status (the solver read from its code at run time). Inlined into run_arrays, as
+    are begin_arrays, solve_arrays and finish_arrays: no call passes the tuples' arrays."""
     m, w, o = model, work, out
     qk, vk = o.q[k], o.v[k]
     if m.motions.shape[0] > 0:  # (a scene without driven obstacles or bodies skips their calls)
@@ -863,16 +867,13 @@ def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
         status = solve_arrays(
             solver_code, k, params, iparams, na, qk, vk, m.minv, m.contacts, m.contact_index, m.joints,
             w.joint_buffer, w.gaps, w.hn, w.ht, w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free,
-            o.p_normal, o.p_tangent, o.counters, scratch.floats, scratch.W, scratch.solver_floats,
-            scratch.solver_ints, scratch.sparse_ints, scratch.sparse_floats, p, u, states)
+            o.p_normal, o.p_tangent, o.counters, scratch, p, u, states)
         if status != KERNEL_SOLVED:
             o.counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
     status = finish_arrays(k, params, iparams, na, p, u, states, qk, vk, m.minv, m.contacts, m.contact_index,
                            m.pair_keys, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht, w.active,
-                           w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o.q, o.v,
-                           o.p_normal, o.p_tangent, o.slip, o.states, o.impact_t, o.impact_step, o.impact_contact,
-                           o.counters, o.joint_impulse)
+                           w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o)
     if m.driven.shape[0] > 0:
         place_driven_arrays(k, m.driven, m.driven_origin, m.motion_now, o.q, o.v)
     return status
@@ -1008,7 +1009,7 @@ def run_arrays(solver_code, k_start, k_first, k_end, params, iparams, extra, scr
     return RUN_OK
 
 
-@jit_borrowing
+@_inlined
 def _after_step(k, k_start, k_end, work, out, memory, before):
     """The rest's bookkeeping after step k: the contacts' memory into the ring, and a rest found
     repeated to k_end (returns the last step so filled, else k)."""

@@ -24,12 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import solvers as _solvers
-from .._jit import jit, jit_borrowing
+from .._jit import jit, jit_borrowing, jit_inline
 # The solver call point: the compiled kernels (registry.SOLVERS with a code); the QP solvers stay
 # Python (solve_two_coefficient below).
 from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix, fits_scratch, fitting_scratch,
                       lemke_interval, pgs_block_into, solve_interval_into, solver_floats, solver_ints)
 from .gauss_seidel import PGS_FLOATS
+from .one_contact import one_contact_into
 from ._common import interpreted
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
                       PlanarFrictionProblem, SolverError)
@@ -58,7 +59,7 @@ class StepContactResult:
     consistent: bool
 
 
-@jit_borrowing
+@jit_inline
 def classify_solution(p, u, residual, mu_s, guess, velocity_tol, states, new_guess):
     """States of a step solution under slip guess `guess`; True when the guess is consistent.
 
@@ -124,7 +125,7 @@ def next_action(new_guess, tried, n_tried):
     return NEXT_STOP if _seen(tried, n_tried, new_guess) else NEXT_TRY_ZERO
 
 
-@jit_borrowing
+@jit_inline
 def _interval_of(mu_s, mu_d, guess, lo, hi):
     """The friction interval [c − μs, c + μs], c = (μs − μd) s, of slip guess s."""
     for j in range(guess.shape[0]):
@@ -189,11 +190,15 @@ def _defaults(rtol, max_iter):
     return rtol <= 0.0 and max_iter <= 0
 
 
-@jit_borrowing
+@jit_inline
 def _solve(solver_code, W, indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     """solve_interval_into on the dense W, or pgs_or_lemke_into when the block-sparse W is given
     (indptr), in the scratch floats, ints. Returns (status, iterations, residual, 1 if pgs fell back
-    to Lemke else 0)."""
+    to Lemke else 0). A group of one contact whose answer is unique takes it in closed form
+    (one_contact.py: every exact solver's answer, without Lemke's tableau): 0 iterations."""
+    residual = one_contact_into(W, blocks, q, lo, hi, p, u)
+    if residual >= 0.0:
+        return KERNEL_SOLVED, 0, residual, 0
     if indptr.shape[0] > 0:
         return pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, _defaults(rtol, max_iter),
                                  floats, ints)
@@ -207,7 +212,7 @@ def _guess_of_states(states, guess):
         guess[i] = 1.0 if states[i] == STATE_SLIP_PLUS else (-1.0 if states[i] == STATE_SLIP_MINUS else 0.0)
 
 
-@jit_borrowing
+@jit_inline
 def hold_at_rest(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting, velocity_tol, closing, p, u,
                  states, p_start):
     """Hold what μs can hold (sticking.prefer_sticking, group by group of coupled contacts) when a
@@ -333,7 +338,7 @@ def two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d,
 GROUP_MIN_CONTACTS = 4
 
 
-@jit_borrowing
+@jit_inline
 def two_coefficient_by_group(solver_code, W, q, mu_s, mu_d, guess, closing, resting, rtol, max_iter, p, u, states,
                              floats, ints):
     """two_coefficient_into on a dense W one group of coupled contacts at a time: W is
