@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
+from nonsmooth_rod.solvers import sticking
 from nonsmooth_rod.solvers.sticking import (STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK, prefer_sticking,
                                             simplex_max)
 from nonsmooth_rod.toys import WedgedRod
@@ -40,6 +41,31 @@ def test_simplex_agrees_with_highs_on_random_lps(compiled):
             assert c @ x == pytest.approx(-ref.fun, rel=1e-9, abs=1e-9)
             assert np.all(G @ x <= h + 1e-9) and np.all(x >= 0)
     assert seen == {0, 1, 3}  # optimal, unbounded and infeasible problems all occurred
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_pivot_on_the_pivot_rows_non_zeros_has_the_bits_of_the_full_update(compiled):
+    """_pivot updates only the columns where the pivot row is non-zero (a hold search's tableau is
+    mostly slack columns, zero in that row); elsewhere the full Gauss–Jordan update would subtract
+    an exact zero. So every entry must come out bit for bit as the full update's — the splits the
+    search chooses cannot move (a tableau with 80 % zeros, and columns zero but in the pivot row)."""
+    pivot = sticking._pivot if compiled else _interpreted(sticking._pivot)
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        m, width = int(rng.integers(2, 30)), int(rng.integers(3, 60))
+        T = rng.normal(size=(m, width)) * (rng.random((m, width)) < 0.2)
+        r, j = int(rng.integers(m - 1)), int(rng.integers(width))
+        T[(r + 1 + int(rng.integers(m - 1))) % m, :] = 0.0  # a row the pivot column does not touch
+        T[r, j] = rng.normal() + 3.0  # a usable pivot
+        expected = T.copy()
+        expected[r, :] /= expected[r, j]
+        for i in range(m):
+            if i != r:
+                expected[i, :] = expected[i, :] - expected[i, j] * expected[r, :]
+        basis = np.zeros(m - 1, dtype=np.int64)
+        pivot(T, basis, r, j, np.empty(width, dtype=np.int64))
+        assert basis[r] == j
+        assert np.array_equal(T, expected)  # bits, not a tolerance
 
 
 def _step_problem(toy, h=H):
