@@ -89,6 +89,18 @@ def row(rows: list[dict], yardstick: float) -> str:
             f" | {np.median([r['cpu_s'] for r in rows]) * 1e6 / yardstick:.0f} |")
 
 
+def positions_table(rows: list[dict], window: float) -> str:
+    """The tol runs' largest position error in each span, one markdown row a run and case."""
+    spans = " | ".join(f"{a:g}–{b:g} s" if b < math.inf else f"{a:g} s–impact" for a, b in SPANS)
+    lines = [f"\n| run | case | {spans} | boundary (s) | impact (s) | evaluations |",
+             "|---|---|" + "---|" * (len(SPANS) + 3)]
+    for r in (r for r in rows if r["positions"] is not None):
+        lines.append(f"| tol = {r['value']:g}, window {window:g} | {r['case']} | " +
+                     " | ".join(f"{e:.1e}" for e in r["positions"]) +
+                     f" | {r['boundary_error_s']:.1e} | {r['impact_error_s']:.1e} | {r['work']} |")
+    return "\n".join(lines)
+
+
 def missed(r: dict) -> bool:
     if not r["ok"]:
         return True
@@ -127,12 +139,7 @@ def main(argv=None) -> int:
         print(row(rows, yardstick))
     flat = [r for rows in table for r in rows]
     if args.positions:
-        print("\n| run | case | " + " | ".join(f"{a:g}–{b:g} s" if b < math.inf else f"{a:g} s–impact" for a, b in SPANS) + " | boundary (s) | impact (s) "
-              "| evaluations |\n|---|---|" + "---|" * (len(SPANS) + 3))
-        for r in (r for r in flat if r["positions"] is not None):
-            print(f"| tol = {r['value']:g}, window {args.window or 1e-2:g} | {r['case']} | " +
-                  " | ".join(f"{e:.1e}" for e in r["positions"]) +
-                  f" | {r['boundary_error_s']:.1e} | {r['impact_error_s']:.1e} | {r['work']} |")
+        print(positions_table(flat, args.window or 1e-2))
     if args.out:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
