@@ -4,14 +4,17 @@ event-driven reference at rtol 1e-12: the phase sequence of ball A, the largest 
 error and ball B's impact error, the work and the cost, for each h (hybrid) and each tol.
 
     python benchmarks/bench_hybrid_cases.py [--h 1e-2 5e-2] [--tol 1e-5 1e-6] [--cases 0 1 ...]
-                                            [--quick] [--out DIR]
+                                            [--window H] [--positions] [--quick] [--out DIR]
 
 Prints a markdown table (docs/error_control.md quotes it), one row per run; with --out, also
 DIR/hybrid_cases.csv, one row per case and run. Work: steps (hybrid) or step evaluations (tol,
 every step of every window run, taken back or not); cost: CPU time of the whole call, median over
 the cases, in yardsticks measured in the same run (benchmarks/yardstick.py). --quick: cases 1, 5 and 9
 (ball A's three sequences among the 25: slip−; stick, slip+; stick, slip−, slip+), hybrid h = 5e-2
-and tol = 1e-6 (a test runs it). Exits 1 if a
+and tol = 1e-6 (a test runs it). --window: the tol runs' first and largest window (default 1e-2 s).
+--positions: for each tol run and case, also the largest |q − q_ref| (x_O, y_O, θ together) over
+0–0.1, 0.1–0.2, 0.2–0.3 s and 0.3 s to ball B's impact, at the run's accepted times, against the
+reference's samples every 1e-4 s (cubic Hermite in q, v). Exits 1 if a
 phase sequence is wrong, or if a tol run has a boundary or the impact off by more than 10 tol.
 """
 from __future__ import annotations
@@ -23,6 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.interpolate import CubicHermiteSpline
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -35,6 +39,7 @@ from nonsmooth_rod.rod.simulation import simulate  # noqa: E402
 N_CASES = 25
 QUICK_CASES = (1, 5, 9)
 TOL_BOUND = 10  # a tol run must have every boundary and the impact within TOL_BOUND · tol (issue 28: 1e-5 at 1e-6)
+SPANS = ((0.0, 0.1), (0.1, 0.2), (0.2, 0.3), (0.3, math.inf))  # s: ball A sticks until 0.30 s in case 0
 COLUMNS = ("run", "value", "case", "mu_s", "mu_d", "phases", "reference_phases", "ok", "boundary_error_s",
            "impact_error_s", "work", "cpu_s")
 
@@ -45,12 +50,24 @@ def cases(seed: int = 0) -> list[tuple[float, float]]:
     return [(float(max(a, b)), float(min(a, b))) for a, b in pairs]
 
 
-def compare(mu_s: float, mu_d: float, reference, run_name: str, value: float) -> dict:
-    """One run ("hybrid" with h = value, or "tol": Moreau–Jean with tol = value) against the reference."""
+def position_errors(run, reference) -> list[float]:
+    """The largest |q − q_ref| in each of SPANS, at the run's samples before ball B's impact."""
+    ref = reference.result.trajectory
+    t_ref, first = np.unique(ref.t, return_index=True)
+    exact = CubicHermiteSpline(t_ref, ref.q[first], ref.v[first], axis=0)
+    t, q = run.result.trajectory.t, run.result.trajectory.q
+    before = t < min(reference.impact["t"] if reference.impact else math.inf, t_ref[-1])
+    error = np.max(np.abs(q[before] - exact(t[before])), axis=1)
+    return [float(error[(t[before] >= a) & (t[before] < b)].max(initial=0.0)) for a, b in SPANS]
+
+
+def compare(mu_s: float, mu_d: float, reference, run_name: str, value: float, window: float | None = None) -> dict:
+    """One run ("hybrid" with h = value, or "tol": Moreau–Jean with tol = value, largest window
+    `window`) against the reference."""
     problem = RodProblem.paper(None, mu_s=mu_s, mu_d=mu_d)
     started = time.process_time()
     run = (simulate(problem, "hybrid", h=value) if run_name == "hybrid"
-           else simulate(problem, "moreau-jean", tol=value))
+           else simulate(problem, "moreau-jean", tol=value, **({"h": window} if window else {})))
     cpu = time.process_time() - started
     got, expected = [p.mode for p in run.phases], [p.mode for p in reference.phases]
     ok = got == expected
@@ -58,7 +75,8 @@ def compare(mu_s: float, mu_d: float, reference, run_name: str, value: float) ->
     impact = abs(run.impact["t"] - reference.impact["t"]) if run.impact and reference.impact else np.nan
     return {"run": run_name, "value": value, "mu_s": mu_s, "mu_d": mu_d, "phases": " ".join(got),
             "reference_phases": " ".join(expected), "ok": ok, "boundary_error_s": boundary, "impact_error_s": impact,
-            "work": run.result.stats.get("step_evaluations", run.result.steps), "cpu_s": cpu}
+            "work": run.result.stats.get("step_evaluations", run.result.steps), "cpu_s": cpu,
+            "positions": position_errors(run, reference) if run_name == "tol" else None}
 
 
 def row(rows: list[dict], yardstick: float) -> str:
@@ -69,6 +87,18 @@ def row(rows: list[dict], yardstick: float) -> str:
             f" | {max(r['boundary_error_s'] for r in rows):.1e} | {np.nanmax([r['impact_error_s'] for r in rows]):.1e}"
             f" | {np.median([r['work'] for r in rows]):.0f} ({max(r['work'] for r in rows)})"
             f" | {np.median([r['cpu_s'] for r in rows]) * 1e6 / yardstick:.0f} |")
+
+
+def positions_table(rows: list[dict], window: float) -> str:
+    """The tol runs' largest position error in each span, one markdown row a run and case."""
+    spans = " | ".join(f"{a:g}–{b:g} s" if b < math.inf else f"{a:g} s–impact" for a, b in SPANS)
+    lines = [f"\n| run | case | {spans} | boundary (s) | impact (s) | evaluations |",
+             "|---|---|" + "---|" * (len(SPANS) + 3)]
+    for r in (r for r in rows if r["positions"] is not None):
+        lines.append(f"| tol = {r['value']:g}, window {window:g} | {r['case']} | " +
+                     " | ".join(f"{e:.1e}" for e in r["positions"]) +
+                     f" | {r['boundary_error_s']:.1e} | {r['impact_error_s']:.1e} | {r['work']} |")
+    return "\n".join(lines)
 
 
 def missed(r: dict) -> bool:
@@ -83,6 +113,8 @@ def main(argv=None) -> int:
     parser.add_argument("--h", type=float, nargs="*", default=None, help="hybrid steps (default 1e-2 5e-2)")
     parser.add_argument("--tol", type=float, nargs="*", default=[], help="Moreau–Jean tolerances")
     parser.add_argument("--cases", type=int, nargs="+", default=None, help="case indices (default all 25)")
+    parser.add_argument("--window", type=float, default=None, help="tol runs' largest window (s)")
+    parser.add_argument("--positions", action="store_true", help="tol runs' position errors by span")
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default=None)
     args = parser.parse_args(argv)
@@ -90,15 +122,15 @@ def main(argv=None) -> int:
     tols = args.tol or ([1e-6] if args.quick else [])
     chosen = args.cases if args.cases is not None else (list(QUICK_CASES) if args.quick else list(range(N_CASES)))
     all_cases = cases()
-    references = {i: simulate(RodProblem.paper(None, mu_s=all_cases[i][0], mu_d=all_cases[i][1]), "event-driven")
-                  for i in chosen}
+    references = {i: simulate(RodProblem.paper(None, mu_s=all_cases[i][0], mu_d=all_cases[i][1]), "event-driven",
+                              output_dt=1e-4 if args.positions else 1e-3) for i in chosen}
     if tols:
         simulate(RodProblem.paper(), "moreau-jean", tol=1e-2)  # warm: compile or load the loop once
     simulate(RodProblem.paper(), "hybrid")  # warm: its kernels and imports
     runs = [("hybrid", h) for h in steps] + [("tol", t) for t in tols]
     table = []
     for name, value in runs:
-        table.append([dict(compare(*all_cases[i], references[i], name, value), case=i) for i in chosen])
+        table.append([dict(compare(*all_cases[i], references[i], name, value, args.window), case=i) for i in chosen])
     yardstick = yardstick_us()
     print(f"yardstick {yardstick:.2f} µs (the machine is shared: compare columns, not absolute times)\n\n"
           "| run | right phase sequences | largest boundary error (s) | largest impact error (s) | "
@@ -106,6 +138,8 @@ def main(argv=None) -> int:
     for rows in table:
         print(row(rows, yardstick))
     flat = [r for rows in table for r in rows]
+    if args.positions:
+        print(positions_table(flat, args.window or 1e-2))
     if args.out:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)

@@ -27,3 +27,14 @@ def test_quick_run_has_the_references_phases_and_boundaries_within_1e_5_s_at_tol
         if r["run"] == "tol":
             assert float(r["boundary_error_s"]) <= 1e-5 and float(r["impact_error_s"]) <= 1e-5
     assert "| Moreau–Jean tol = 1e-06 | 3/3 |" in capsys.readouterr().out
+
+
+def test_positions_by_span_against_the_reference(capsys):
+    """--positions: case 0 (ball A sticks 0.30 s, then slips forward) at tol = 1e-4 keeps x_O, y_O
+    and θ within tol of the event-driven reference in every span; the table has one row a case."""
+    bench = _bench()
+    assert bench.main(["--h", "--tol", "1e-4", "--cases", "0", "--positions"]) == 0
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if line.startswith("| tol = 0.0001, window 0.01 | 0 |"))
+    spans = [float(cell) for cell in row.strip("|").split("|")[2:2 + len(bench.SPANS)]]
+    assert len(spans) == 4 and all(0.0 < e <= 1e-4 for e in spans), spans
