@@ -60,7 +60,10 @@ def run(method: str, options: dict, stop: bool):
 
 def measure(method: str, options: dict, repeat: int) -> dict:
     run(method, options, True)  # warm: imports, a compiled loop's cache
-    full = [run(method, options, False)[0] for _ in range(repeat)]
+    full = []
+    for _ in range(repeat):
+        cpu, whole = run(method, options, False)
+        full.append(cpu)
     stopped = []
     for _ in range(repeat):
         cpu, result = run(method, options, True)
@@ -68,7 +71,13 @@ def measure(method: str, options: dict, repeat: int) -> dict:
     t_star = math.sqrt(2.0 * drop_in(STOP_TIME) / G)
     return {"method": method, "options": options, "full_s": statistics.median(full),
             "stopped_s": statistics.median(stopped), "status": str(result.status), "t_stop": float(result.t[-1]),
-            "t_star": t_star, "samples": len(result.t)}
+            "t_star": t_star, "samples": len(result.t), "reached_full": reached(whole, options), "reached_stopped": reached(result, options)}
+
+
+def reached(result, options: dict) -> float:
+    """The time a run integrated to (the ODE methods' t_final; Moreau–Jean's steps of h from 0),
+    whatever samples it kept: a stop that only trimmed the result would reach t_end."""
+    return float(result.stats["t_final"]) if "t_final" in result.stats else result.steps * options["h"]
 
 
 def table(rows: list) -> str:
