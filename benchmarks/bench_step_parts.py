@@ -6,8 +6,9 @@ contacts against the same tower declared by hand, in one process.
 The tower of benchmarks/bench_shapes.py (declared, found) runs 1000 steps to its rest, then each part of the step at that state is repeated --reps times in a
 compiled loop of its own (numba; CPU time per call, median of --rounds, the scenes alternated):
 `begin` (free velocity, broad phase, kinematics, active set), `broad` (the broad phase alone:
-broad_candidates on its kept list, built by the first call — the tower at rest never rebuilds it;
-the declared tower's step runs none — too few disk pairs — so its column is the test alone), `solve` (assemble and the two-coefficient Lemke solve),
+broad_candidates on its kept list, built by the first call — the tower at rest never rebuilds
+it; the declared tower's step runs none — too few disk pairs — so its column is the test alone),
+`solve` (assemble and the two-coefficient Lemke solve),
 `finish` (end velocity and state, every contact's records — rows cycled over a window of 4000 steps,
 as a run writes them —, impacts, memory), `finish 1 row` (the same on one row: the records' memory
 traffic is the difference) and `after` (the rest's ring), then the whole loop for 4000 steps from

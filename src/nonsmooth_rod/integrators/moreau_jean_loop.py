@@ -31,7 +31,8 @@ from .._jit import jit, jit_borrowing
 
 _inlined = _jit.jit_inline  # the small per-contact helpers, compiled into the step's functions
 from ..model.contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
-                                      C_MOTION, C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
+                                      C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
+                                      C_MOTION,
                                       KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
 from ..model.forces import accumulate_forces
 from .carved import carve_zeros
@@ -476,7 +477,8 @@ def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, wa
     for i in range(table.shape[0]):
         if index[i, CI_KIND] != KIND_DISK_ON_LINE:
             continue
-        still = table[i, C_MOTION] < 0.0 and table[i, C_OBSTACLE_START_VX] == 0.0 and table[i, C_OBSTACLE_START_VY] == 0.0
+        still = (table[i, C_MOTION] < 0.0 and table[i, C_OBSTACLE_START_VX] == 0.0
+                 and table[i, C_OBSTACLE_START_VY] == 0.0)
         if still and not was_closed[i] and (_line_clearance(0.0, q, v, table, index, i) - 0.5 * skin
                                             > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK):
             candidate[i] = 0
