@@ -6,8 +6,9 @@ contacts against the same tower declared by hand, in one process.
 The tower of benchmarks/bench_shapes.py (declared, found) runs 1000 steps to its rest, then each part of the step at that state is repeated --reps times in a
 compiled loop of its own (numba; CPU time per call, median of --rounds, the scenes alternated):
 `begin` (free velocity, broad phase, kinematics, active set), `broad` (the broad phase alone:
-_mark_candidates and lines_in_reach; the declared tower's step runs none — too few disk pairs —
-so its column is the test alone), `solve` (assemble and the two-coefficient Lemke solve),
+broad_candidates on its kept list, built by the first call — the tower at rest never rebuilds
+it; the declared tower's step runs none — too few disk pairs — so its column is the test alone),
+`solve` (assemble and the two-coefficient Lemke solve),
 `finish` (end velocity and state, every contact's records — rows cycled over a window of 4000 steps,
 as a run writes them —, impacts, memory), `finish 1 row` (the same on one row: the records' memory
 traffic is the difference) and `after` (the rest's ring), then the whole loop for 4000 steps from
@@ -46,17 +47,17 @@ def _harness():
         for _ in range(reps):
             na = L.begin_arrays(params, o.q[k], o.v[k], f, m.minv, m.contacts, m.contact_index, m.disks, m.disk_body,
                                 m.pair_keys, m.pair_contact, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht,
-                                w.active, w.was_closed, w.v_free, w.a_free, w.candidate, s.floats)
+                                w.active, w.was_closed, w.v_free, w.a_free, w.candidate, s.floats, s.kept,
+                                s.kept_pose)
         return na
 
     @numba.njit
     def broad(reps, params, f, m, w, o, s, k):
         h = params[L.P_H]
         for _ in range(reps):
-            L._mark_candidates(h, o.q[k], o.v[k], m.disks, m.disk_body, m.pair_keys, m.pair_contact, w.was_closed,
-                               w.candidate, s.floats)
-            L.lines_in_reach(h * abs(params[L.P_GAMMA]), o.q[k], o.v[k], m.contacts, m.contact_index, w.was_closed,
-                             w.candidate)
+            L.broad_candidates(h, params[L.P_GAMMA], o.q[k], o.v[k], m.disks, m.disk_body, m.pair_keys,
+                               m.pair_contact, m.contacts, m.contact_index, w.was_closed, w.candidate, s.floats,
+                               s.kept, s.kept_pose)
         return 0
 
     @numba.njit

@@ -135,3 +135,114 @@ def test_fast_boxes_do_not_pass_through_the_floor_or_each_other():
     assert deepest_overlap(bodies, shapes, q, [Line()]) <= deepest
     struck = {frozenset(side.split(".")[0] for side in i.contact.split("/")) for i in result.impacts}
     assert {frozenset({"still", "thrown"}), frozenset({"dropped", "floor"})} <= struck
+
+
+def _kept_marks(packed, q_build, q, v, h, gamma):
+    """broad_candidates' marks at (q, v) on a kept list built at q_build (as a run's step after
+    its build), and whether (q, v) asked for a rebuild; with the scratch a run gives it."""
+    from nonsmooth_rod.integrators import moreau_jean_loop as loop
+
+    nc, n_dof = packed.n_contacts, q.size
+    n_kept, n_pose = loop.kept_sizes(n_dof, packed.disks.shape[0], nc, packed.pair_keys.shape[0])
+    kept, kept_pose = np.zeros(n_kept, dtype=np.int64), np.zeros(n_pose)
+    candidate, was_closed, room = np.ones(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.empty(11 * nc)
+    args = (packed.disks, packed.disk_body, packed.pair_keys, packed.pair_contact, packed.contacts,
+            packed.contact_index, was_closed, candidate, room, kept, kept_pose)
+    loop.broad_candidates(h, gamma, q_build, np.zeros(n_dof), *args)  # the build
+    loop.broad_candidates(h, gamma, q, v, *args)
+    return candidate, kept[0] + kept[1], not np.array_equal(kept_pose[:n_dof], q_build)  # (the pose of the build)
+
+
+def _within_skin(packed, q_build, rng, h, gamma, share):
+    """A state (q, v) whose displacement bound from q_build (broad_candidates' docstring) uses
+    `share` of BROAD_PHASE_REBUILD × the skin per body, spread over translation, turn and speed."""
+    from nonsmooth_rod.integrators import moreau_jean_loop as loop
+
+    n_dof = q_build.size
+    pose = np.zeros(n_dof + n_dof // 3 + 2)
+    skin = loop._skin_and_levers(packed.disks, packed.disk_body, packed.contacts, packed.contact_index, pose, n_dof)
+    levers, budget = pose[n_dof: n_dof + n_dof // 3], share * loop.BROAD_PHASE_REBUILD * skin
+    parts = rng.dirichlet(np.ones(3), size=n_dof // 3) * budget  # translation, turn, one step's travel
+    direction = rng.normal(size=(n_dof // 3, 3))
+    dq, v = np.zeros((n_dof // 3, 3)), np.zeros((n_dof // 3, 3))
+    signs = np.sign(direction[:, :2])
+    dq[:, :2] = signs * (parts[:, :1] / 2)
+    dq[:, 2] = np.sign(direction[:, 2]) * parts[:, 1] / levers
+    step = h * max(1.0, abs(gamma))
+    v[:, :2] = -signs * (parts[:, 2:] / 4) / step  # half the travel in translation, half in the turn
+    v[:, 2] = np.sign(direction[:, 2]) * (parts[:, 2] / 2) / (levers * step)
+    return q_build + dq.ravel(), v.ravel()
+
+
+def _boxes_near_touching(n, seed):
+    """A leaning tower of n boxes (found contacts, each pair and the floor), each a random gap
+    (−3 mm … 1 cm, within the 3 cm skin) above the one below, shifted up to 15 cm and turned up to
+    0.05 rad: features on both sides of every reach."""
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.model.collision import find_contacts
+
+    rng = np.random.default_rng(seed)
+    bodies = [RigidBody(1.0, 0.02, f"box{k}") for k in range(n)]
+    shapes = {b.name: nr.Polygon.rectangle(0.4, 0.3) for b in bodies}
+    contacts = find_contacts(bodies, shapes, {"floor": Line()})
+    tilt = rng.uniform(-0.05, 0.05, n)
+    lift = 0.15 * np.cos(tilt) + 0.2 * np.abs(np.sin(tilt))  # the lowest corner's height over the centre
+    y = np.cumsum(2 * lift + rng.uniform(-3e-3, 1e-2, n)) - lift
+    q = np.column_stack([rng.uniform(-0.15, 0.15, n), y, tilt])
+    return pack_scene(Scene(bodies, contacts)), q.ravel()
+
+
+def test_the_kept_list_marks_what_the_whole_broad_phase_marks():
+    """Verlet lists: the kept list built at one pose, tested at another whose circles moved by up to
+    the rebuild bound (translation, turn and one step's travel at 25–60 m/s — the skin is 3 cm:
+    these are h = 1e-4 steps), marks exactly the contacts the whole broad phase (each listed pair,
+    and lines_in_reach) marks there — and so keeps every contact the step activates — while
+    holding far fewer than are listed; past the bound, the list is rebuilt."""
+    from nonsmooth_rod.integrators.moreau_jean_loop import ACTIVATION_ROUNDOFF
+    from nonsmooth_rod.model.packing import contact_kinematics, row_dot
+
+    rng = np.random.default_rng(7)
+    h, gamma, activated, in_reach, kept_total, listed_total = 1e-4, 0.5, 0, 0, 0, 0
+    for seed in range(20):
+        packed, q_build = _boxes_near_touching(4, seed)
+        q, v = _within_skin(packed, q_build, rng, h, gamma, 0.999)
+        marks, n_kept, rebuilt = _kept_marks(packed, q_build, q, v, h, gamma)
+        assert not rebuilt
+        whole = _candidates(packed, q, v, h, False)  # lines_in_reach at 0.5 h: γ h
+        assert np.array_equal(marks, whole), seed
+        hn, ht = np.zeros((packed.n_contacts, 6)), np.zeros((packed.n_contacts, 6))
+        for i in range(packed.n_contacts):
+            gap, _ = contact_kinematics(packed.contacts, packed.contact_index, i, q, v, hn[i], ht[i])
+            if gap + gamma * h * row_dot(hn, packed.contact_index, i, v) <= ACTIVATION_ROUNDOFF:
+                activated += 1
+                assert marks[i] == 1, (seed, i)
+        in_reach += int(np.sum(whole))
+        kept_total += n_kept
+        listed_total += packed.pair_keys.shape[0] + 4 * 4
+        q_far, v_far = _within_skin(packed, q_build, rng, h, gamma, 1.2)
+        assert _kept_marks(packed, q_build, q_far, v_far, h, gamma)[2]  # past the bound: rebuilt
+    assert activated > 10 and kept_total < 0.5 * listed_total  # cases on both sides, and a list that keeps few
+    assert in_reach < packed.n_contacts * 12  # some contacts left out (the comparison is not all ones)
+
+
+def test_a_run_on_kept_lists_is_the_run_rebuilding_them_every_step():
+    """Boxes thrown onto a floor and onto each other (found contacts), h = 1 ms: the compiled loop's
+    whole run keeps its broad-phase list between rebuilds; the same run with a (zero) Python force
+    goes one step a call, each call building the list afresh. Same trajectory and impulses, bit
+    for bit (the kept list marks the very same candidates)."""
+    import nonsmooth_rod as nr
+    from nonsmooth_rod.model.collision import find_contacts
+
+    bodies = [RigidBody(1.0, 0.02, f"box{k}") for k in range(3)]
+    shapes = {b.name: nr.Polygon.rectangle(0.4, 0.3) for b in bodies}
+    contacts = find_contacts(bodies, shapes, {"floor": Line()}, nr.PairLaws(default=ContactLaw.of(0.5, 0.4, 0.2)))
+    q0 = np.array([0.0, 0.15, 0.0, -0.7, 0.5, 0.3, 0.1, 0.9, -0.2])
+    v0 = np.array([0.0, 0.0, 0.0, 4.0, 1.0, -2.0, 0.5, -3.0, 5.0])
+    runs = [nr.simulate(Scene(bodies, contacts, applied_force=force), q0, v0, 0.4, "moreau-jean", h=1e-3)
+            for force in (None, lambda t, q, v: np.zeros(9))]
+    assert all(r.status == "ok" for r in runs), [r.message for r in runs]
+    kept, rebuilt = runs
+    assert np.array_equal(kept.trajectory.q, rebuilt.trajectory.q)
+    assert np.array_equal(kept.trajectory.v, rebuilt.trajectory.v)
+    assert [(i.contact, i.t) for i in kept.impacts] == [(i.contact, i.t) for i in rebuilt.impacts]
+    assert len({i.contact for i in kept.impacts}) >= 4  # boxes struck the floor and each other

@@ -35,6 +35,7 @@ from .._jit import jit, jit_borrowing
 _inlined = _jit.jit_inline  # the small per-contact helpers, compiled into the step's functions
 from ..model.contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
                                       C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
+                                      C_MOTION,
                                       KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
 from ..model.forces import accumulate_forces
 from .carved import carve_zeros
@@ -127,7 +128,9 @@ Records = namedtuple("Records", "q v p_normal p_tangent slip states impact_t imp
                      "joint_impulse")
 # A step's temporaries (step_scratch), allocated once per call of the loop; need: the step and
 # active contacts a RUN_SCRATCH_SHORT asks room for.
-Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints sparse_ints sparse_floats need")
+# kept, kept_pose: the broad phase's kept list (broad_candidates), rebuilt at each call's first step.
+Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints sparse_ints sparse_floats need kept "
+                     "kept_pose")
 
 
 def new_records(n_dof, n_contacts, rows, impacts, joint_rows):
@@ -305,14 +308,215 @@ def lines_in_reach(reach_time, q, v, table, index, was_closed, candidate):
     for i in range(table.shape[0]):
         if index[i, CI_KIND] != KIND_DISK_ON_LINE or was_closed[i]:
             continue
-        j = 3 * index[i, CI_BODY_A]
-        ox, oy = table[i, C_OFF_AX], table[i, C_OFF_AY]
-        wx, wy = table[i, C_OBSTACLE_START_VX], table[i, C_OBSTACLE_START_VY]
-        lever = math.sqrt(ox * ox + oy * oy)
-        centre = table[i, C_NX] * (q[j] - table[i, C_LINE_PX]) + table[i, C_NY] * (q[j + 1] - table[i, C_LINE_PY])
-        speed = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1]) + abs(v[j + 2]) * lever + math.sqrt(wx * wx + wy * wy)
-        if centre - lever - table[i, C_RADIUS_A] - reach_time * speed > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK:
+        if _line_clearance(reach_time, q, v, table, index, i) > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK:
             candidate[i] = 0
+
+
+@_inlined
+def _line_clearance(reach_time, q, v, table, index, i):
+    """How far contact i's point or disk (on a line) stays from the line in `reach_time` at most:
+    its body's centre from the line, less the point's lever and radius and what its fastest point
+    and the line close in that time (lines_in_reach leaves it out when this is positive)."""
+    j = 3 * index[i, CI_BODY_A]
+    ox, oy = table[i, C_OFF_AX], table[i, C_OFF_AY]
+    wx, wy = table[i, C_OBSTACLE_START_VX], table[i, C_OBSTACLE_START_VY]
+    lever = math.sqrt(ox * ox + oy * oy)
+    centre = table[i, C_NX] * (q[j] - table[i, C_LINE_PX]) + table[i, C_NY] * (q[j + 1] - table[i, C_LINE_PY])
+    speed = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1]) + abs(v[j + 2]) * lever + math.sqrt(wx * wx + wy * wy)
+    return centre - lever - table[i, C_RADIUS_A] - reach_time * speed
+
+
+# The broad phase's kept list (Verlet lists with a skin, as molecular dynamics' neighbour lists and
+# Box2D's fat boxes; broad_candidates): the circle pairs and points on lines within the skin s of
+# each other at a build, tested each step until some body may have moved by BROAD_PHASE_REBUILD s.
+# s: this fraction of the scene's smallest circle radius > 0 (half its shortest edge, its smallest
+# disk), small against every shape, so that the list holds few more pairs than touch.
+BROAD_PHASE_SKIN = 0.2
+# Below 1/2 (the proof in broad_candidates' docstring): the rest is room for round-off.
+BROAD_PHASE_REBUILD = 0.45
+
+
+@jit
+def kept_sizes(n_dof, n_circles, n_contacts, n_pairs):
+    """The sizes of Scratch.kept (ints: the counts of kept pairs and lines, a (contact, circle,
+    circle) triple per kept pair, the kept lines' contacts) and Scratch.kept_pose (floats, _pose_views:
+    q at the build, each body's lever, the skin and 1 once built; then the circles' centres, the q
+    they were placed at and each circle's lever); none without a broad phase."""
+    if n_pairs <= BROAD_PHASE_MIN_PAIRS:
+        return 0, 0
+    return 2 + 3 * n_pairs + n_contacts, 2 * n_dof + n_dof // 3 + 2 + 3 * n_circles
+
+
+@_inlined
+def _pose_views(kept_pose, n_dof, n_circles):
+    """(the build's pose block: q, levers, skin, built flag; the circles' centres x, y; the q
+    they were placed at; each circle's lever |o| + r) — views of Scratch.kept_pose."""
+    pose, at = carve(kept_pose, 0, n_dof + n_dof // 3 + 2)
+    x, at = carve(kept_pose, at, n_circles)
+    y, at = carve(kept_pose, at, n_circles)
+    placed, at = carve(kept_pose, at, n_dof)
+    levers, at = carve(kept_pose, at, n_circles)
+    return pose, x, y, placed, levers
+
+
+@jit_borrowing
+def _circles_now(h, q, v, disks, disk_body, x, y, placed, levers, reach, turn):
+    """_disk_reach's centres and reach, the very same floats, on the kept list's memory: a body's
+    circles are placed again only when its q changed since they were (a body at rest costs no
+    cos, sin), and each circle's lever is the one _keep_near computed. turn: scratch of 4 floats a
+    body (cos θ, sin θ, |v|, whether it moved)."""
+    for body in range(q.shape[0] // 3):
+        j, at = 3 * body, 4 * body
+        moved = q[j] != placed[j] or q[j + 1] != placed[j + 1] or q[j + 2] != placed[j + 2]
+        turn[at + 3] = 1.0 if moved else 0.0
+        if moved:
+            turn[at], turn[at + 1] = math.cos(q[j + 2]), math.sin(q[j + 2])
+            placed[j], placed[j + 1], placed[j + 2] = q[j], q[j + 1], q[j + 2]
+        turn[at + 2] = math.sqrt(v[j] * v[j] + v[j + 1] * v[j + 1])
+    for d in range(disks.shape[0]):
+        if disk_body[d] < 0:  # a fixed circle (placed by _keep_near)
+            reach[d] = disks[d, 2] + BROAD_PHASE_SLACK
+            continue
+        j, at = 3 * disk_body[d], 4 * disk_body[d]
+        if turn[at + 3] != 0.0:
+            ox, oy, c, s = disks[d, 0], disks[d, 1], turn[at], turn[at + 1]
+            x[d] = q[j] + c * ox - s * oy
+            y[d] = q[j + 1] + s * ox + c * oy
+        speed = turn[at + 2] + abs(v[j + 2]) * levers[d]
+        reach[d] = disks[d, 2] + h * speed + BROAD_PHASE_SLACK
+
+
+@jit_borrowing
+def broad_candidates(h, gamma, q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate,
+                     room, kept, kept_pose):
+    """The step's broad phase: the candidates _mark_candidates and lines_in_reach(γ h) mark, tested
+    by the same tests but only over a kept list (Scratch.kept; _keep_near builds it) while no body
+    has moved past the skin since its build (empty kept, or no room: those two on every contact).
+
+    Why the kept list holds every candidate: a circle at offset o (lever ℓ = |o| + r ≤ L, its
+    body's lever) has its centre within D = |Δx|₁ + |Δθ| L of where it was at the build, and its
+    reach this step is r + h (|v| + |ω| ℓ) + slack ≤ r + S + slack with S = h max(1, |γ|)
+    (|v|₁ + |ω| L). While D + S ≤ BROAD_PHASE_REBUILD s < s/2 for every body (_past_skin), two
+    circles in reach now (per axis, centres within the sum of reaches) had centres within
+    rₐ + r_b + 2 slack + s at the build: the build's test with each reach r + s/2 + slack kept
+    them. A point on a fixed line: its clearance now (_line_clearance, γ h) is at least its
+    clearance at the build less D + S, so one that cleared s/2 at the build is still out; a
+    driven or moving line's contacts are always kept. A contact closed at the build is kept, and
+    one closes later only as a candidate, hence kept. Each step then marks exactly what the
+    full broad phase marks (tests/integrators/test_broad_phase.py), so results are unchanged."""
+    n, n_dof = disks.shape[0], q.shape[0]
+    if kept.shape[0] == 0 or kept_pose.shape[0] == 0 or n + 4 * (n_dof // 3) > room.shape[0]:
+        _mark_candidates(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate, room)
+        lines_in_reach(h * abs(gamma), q, v, table, index, was_closed, candidate)
+        return
+    pose, x, y, placed, levers = _pose_views(kept_pose, n_dof, n)
+    if pose[n_dof + n_dof // 3 + 1] == 0.0 or _past_skin(h * max(1.0, abs(gamma)), q, v, pose):
+        _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate, kept,
+                   kept_pose)
+    reach, at = carve(room, 0, n)
+    turn, at = carve(room, at, 4 * (n_dof // 3))
+    _circles_now(h, q, v, disks, disk_body, x, y, placed, levers, reach, turn)
+    for k in range(kept[0]):
+        i = kept[2 + 3 * k]
+        candidate[i] = 1 if was_closed[i] or _in_reach(x, y, reach, kept[3 + 3 * k], kept[4 + 3 * k]) else 0
+    lines = 2 + 3 * pair_keys.shape[0]
+    for k in range(kept[1]):
+        i = kept[lines + k]
+        out = not was_closed[i] and (_line_clearance(h * abs(gamma), q, v, table, index, i)
+                                     > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK)
+        candidate[i] = 0 if out else 1
+
+
+@_inlined
+def _past_skin(step, q, v, kept_pose):
+    """Whether some body may have moved its circles, since the kept list's build, plus what one
+    step of `step` seconds adds at its velocity, by more than BROAD_PHASE_REBUILD × the skin
+    (|Δx|₁ + |Δθ| L + step (|v|₁ + |ω| L), L its lever). A non-finite state rebuilds."""
+    n_dof = q.shape[0]
+    n_bodies = n_dof // 3
+    limit = BROAD_PHASE_REBUILD * kept_pose[n_dof + n_bodies]
+    for b in range(n_bodies):
+        j, lever = 3 * b, kept_pose[n_dof + b]
+        moved = abs(q[j] - kept_pose[j]) + abs(q[j + 1] - kept_pose[j + 1]) + abs(q[j + 2] - kept_pose[j + 2]) * lever
+        moved += step * (abs(v[j]) + abs(v[j + 1]) + abs(v[j + 2]) * lever)
+        if not moved <= limit:
+            return True
+    return False
+
+
+@jit
+def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate, kept, kept_pose):
+    """Build the kept list at pose q (broad_candidates): the listed circle pairs within each
+    other's radius + s/2 + slack or closed (found as the broad phase finds pairs in reach:
+    each tested, or swept), and the points on lines closed, on a driven or moving line, or
+    within s/2 of it; every other such contact's candidate set to 0 until the next build (the
+    contacts the broad phase never leaves out: 1). Records the pose, the levers and the skin."""
+    n, n_dof = disks.shape[0], q.shape[0]
+    pose, x, y, placed, levers = _pose_views(kept_pose, n_dof, n)
+    skin = _skin_and_levers(disks, disk_body, table, index, pose, n_dof)
+    reach, turn = np.empty(n), np.empty(n_dof)
+    _disk_reach(0.0, q, v, disks, disk_body, x, y, reach, turn)  # the centres; reach r + slack
+    for d in range(n):
+        reach[d] += 0.5 * skin
+        levers[d] = math.sqrt(disks[d, 0] * disks[d, 0] + disks[d, 1] * disks[d, 1]) + disks[d, 2]  # as _disk_reach
+    for j in range(n_dof):
+        placed[j] = q[j]  # where the centres now are (_circles_now places a body again when it moves)
+    for i in range(candidate.shape[0]):
+        candidate[i] = 1
+    if pair_keys.shape[0] <= PAIRS_PER_CIRCLE_TESTED * n:
+        _listed_pairs_in_reach(x, y, reach, pair_keys, pair_contact, was_closed, candidate)
+    else:
+        along, across = (y, x) if np.max(y) - np.min(y) > np.max(x) - np.min(x) else (x, y)
+        _sweep_and_prune(along, across, reach, np.argsort(along), disk_body, pair_keys, pair_contact, was_closed,
+                         candidate)
+    count, da = 0, 0
+    for j in range(pair_keys.shape[0]):
+        while pair_keys[j] >= (da + 1) * n:
+            da += 1
+        if candidate[pair_contact[j]]:
+            kept[2 + 3 * count], kept[3 + 3 * count], kept[4 + 3 * count] = pair_contact[j], da, pair_keys[j] - da * n
+            count += 1
+    kept[0], lines, count = count, 2 + 3 * pair_keys.shape[0], 0
+    for i in range(table.shape[0]):
+        if index[i, CI_KIND] != KIND_DISK_ON_LINE:
+            continue
+        still = (table[i, C_MOTION] < 0.0 and table[i, C_OBSTACLE_START_VX] == 0.0
+                 and table[i, C_OBSTACLE_START_VY] == 0.0)
+        if still and not was_closed[i] and (_line_clearance(0.0, q, v, table, index, i) - 0.5 * skin
+                                            > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK):
+            candidate[i] = 0
+        else:
+            kept[lines + count] = i
+            count += 1
+    kept[1] = count
+    for d in range(n_dof):
+        pose[d] = q[d]
+    pose[n_dof + n_dof // 3 + 1] = 1.0
+
+
+@jit_borrowing
+def _skin_and_levers(disks, disk_body, table, index, kept_pose, n_dof):
+    """The skin s (BROAD_PHASE_SKIN × the smallest circle radius > 0; 0 without one: rebuilt
+    whenever anything moves), written after each body's lever L (the farthest reach of its
+    circles, |o| + r, and of its points on lines, |o|, from its centre) in kept_pose; returns s."""
+    n_bodies = n_dof // 3
+    for b in range(n_bodies):
+        kept_pose[n_dof + b] = 0.0
+    smallest = math.inf
+    for d in range(disks.shape[0]):
+        r = disks[d, 2]
+        if r > 0.0:
+            smallest = min(smallest, r)
+        if disk_body[d] >= 0:
+            at = n_dof + disk_body[d]
+            kept_pose[at] = max(kept_pose[at], math.sqrt(disks[d, 0] ** 2 + disks[d, 1] ** 2) + r)
+    for i in range(table.shape[0]):
+        if index[i, CI_KIND] == KIND_DISK_ON_LINE:
+            at = n_dof + index[i, CI_BODY_A]
+            kept_pose[at] = max(kept_pose[at], math.sqrt(table[i, C_OFF_AX] ** 2 + table[i, C_OFF_AY] ** 2))
+    skin = BROAD_PHASE_SKIN * smallest if smallest < math.inf else 0.0
+    kept_pose[n_dof + n_bodies] = skin
+    return skin
 
 
 @jit_borrowing
@@ -344,15 +548,17 @@ def begin_step(params, qk, vk, f, model, work):
     return begin_arrays(params, qk, vk, f, model.minv, model.contacts, model.contact_index, model.disks,
                         model.disk_body, model.pair_keys, model.pair_contact, model.joints, work.joint_buffer,
                         work.gaps, work.drifts, work.hn, work.ht, work.active, work.was_closed, work.v_free,
-                        work.a_free, work.candidate, np.empty(0))
+                        work.a_free, work.candidate, np.empty(0), np.empty(0, dtype=np.int64), np.empty(0))
 
 
 @_inlined
 def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_keys, pair_contact, joints,
-                 joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate, room):
+                 joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate, room, kept,
+                 kept_pose):
     """Free velocity, contact kinematics and the active set; returns na (< 0: geometry_failure's
     code: −1 − i, contact i's normal undefined; −1 − n_contacts − i, contact i passed through).
-    room: floats the broad phase may use (the step's scratch, free until the solve; empty: none)."""
+    room: floats the broad phase may use (the step's scratch, free until the solve; empty: none);
+    kept, kept_pose: its kept list (Scratch's; empty: none, every contact tested)."""
     h, gamma = params[P_H], params[P_GAMMA]
     for d in range(qk.shape[0]):
         a_free[d] = minv[d] * f[d]
@@ -361,8 +567,8 @@ def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_k
         _joints_begin(qk, minv, joints, joint_buffer, v_free, a_free)
     broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
     if broad:
-        _mark_candidates(h, qk, vk, disks, disk_body, pair_keys, pair_contact, was_closed, candidate, room)
-        lines_in_reach(h * abs(gamma), qk, vk, table, index, was_closed, candidate)
+        broad_candidates(h, gamma, qk, vk, disks, disk_body, pair_keys, pair_contact, table, index, was_closed,
+                         candidate, room, kept, kept_pose)
     na = 0
     for i in range(table.shape[0]):
         if broad and not candidate[i]:
@@ -773,9 +979,10 @@ def step_scratch(solver_code, model, dense_contacts):
     else:
         solver_floats, solver_ints = solver_scratch(min(n_contacts, SCRATCH_SOLVER_CONTACTS))
     sparse_ints = 2 * n_bodies + 4 * n_contacts + 3 + blocks if sparse else 0
+    n_kept, n_pose = kept_sizes(model.minv.shape[0], model.disks.shape[0], n_contacts, model.pair_keys.shape[0])
     return Scratch(np.empty(11 * n_contacts), np.empty(n_contacts, dtype=np.int64), np.empty(4 * dense * dense),
                    solver_floats, solver_ints, np.empty(sparse_ints, dtype=np.int64), np.empty(4 * blocks),
-                   np.zeros(2, dtype=np.int64))
+                   np.zeros(2, dtype=np.int64), np.zeros(n_kept, dtype=np.int64), np.zeros(n_pose))
 
 
 @_inlined
@@ -854,7 +1061,7 @@ def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
         drive_arrays(k, params, m.contacts, m.motions, m.motion_times, m.motion_values, m.motion_now)
     na = begin_arrays(params, qk, vk, f, m.minv, m.contacts, m.contact_index, m.disks, m.disk_body, m.pair_keys,
                       m.pair_contact, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht, w.active, w.was_closed,
-                      w.v_free, w.a_free, w.candidate, scratch.floats)
+                      w.v_free, w.a_free, w.candidate, scratch.floats, scratch.kept, scratch.kept_pose)
     if na < 0:
         return geometry_failure(na, m.contacts.shape[0], o.counters)
     if m.driven.shape[0] > 0:
