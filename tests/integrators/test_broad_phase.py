@@ -26,6 +26,20 @@ def _row(n, all_pairs):
     return Scene(bodies, contacts), q0, v0
 
 
+
+def _activated(packed, q, v, h, gamma) -> list:
+    """The contacts the step would activate at (q, v): gap + γ h u_N within the activation's round-off."""
+    from nonsmooth_rod.integrators.moreau_jean_loop import ACTIVATION_ROUNDOFF
+    from nonsmooth_rod.model.packing import contact_kinematics, row_dot
+
+    hn, ht = np.zeros((packed.n_contacts, 6)), np.zeros((packed.n_contacts, 6))
+    found = []
+    for i in range(packed.n_contacts):
+        gap, _ = contact_kinematics(packed.contacts, packed.contact_index, i, q, v, hn[i], ht[i])
+        if gap + gamma * h * row_dot(hn, packed.contact_index, i, v) <= ACTIVATION_ROUNDOFF:
+            found.append(i)
+    return found
+
 def test_all_pairs_listed_give_the_neighbours_run():
     # 15 listed pairs go through the broad phase (more than BROAD_PHASE_MIN_PAIRS), the 5 neighbour
     # pairs do not: the sorted and the unsorted run must agree
@@ -88,20 +102,14 @@ def test_the_broad_phase_leaves_out_no_contact_the_step_activates():
     tested (each listed pair, or sweep and prune), and for a point on the line, every contact
     whose activation test (predicted gap γ h ahead ≤ the round-off margin) holds this step is
     kept — fast bodies close to each other included — and both ways keep the same contacts."""
-    from nonsmooth_rod.integrators.moreau_jean_loop import ACTIVATION_ROUNDOFF
-    from nonsmooth_rod.model.packing import contact_kinematics, row_dot
-
     h, gamma, activated, left_out = 1e-2, 0.5, 0, 0
     for seed in range(12):
         packed, q, v = _boxes_on_a_floor(4, seed)
         listed, swept = _candidates(packed, q, v, h, False), _candidates(packed, q, v, h, True)
         assert np.array_equal(listed, swept)
-        hn, ht = np.zeros((packed.n_contacts, 6)), np.zeros((packed.n_contacts, 6))
-        for i in range(packed.n_contacts):
-            gap, _ = contact_kinematics(packed.contacts, packed.contact_index, i, q, v, hn[i], ht[i])
-            if gap + gamma * h * row_dot(hn, packed.contact_index, i, v) <= ACTIVATION_ROUNDOFF:
-                activated += 1
-                assert listed[i] == 1, (seed, i)
+        for i in _activated(packed, q, v, h, gamma):
+            activated += 1
+            assert listed[i] == 1, (seed, i)
         left_out += int(np.sum(listed == 0))
     assert activated > 50 and left_out > 100  # the check has cases on both sides
 
@@ -198,9 +206,6 @@ def test_the_kept_list_marks_what_the_whole_broad_phase_marks():
     these are h = 1e-4 steps), marks exactly the contacts the whole broad phase (each listed pair,
     and lines_in_reach) marks there — and so keeps every contact the step activates — while
     holding far fewer than are listed; past the bound, the list is rebuilt."""
-    from nonsmooth_rod.integrators.moreau_jean_loop import ACTIVATION_ROUNDOFF
-    from nonsmooth_rod.model.packing import contact_kinematics, row_dot
-
     rng = np.random.default_rng(7)
     h, gamma, activated, in_reach, kept_total, listed_total = 1e-4, 0.5, 0, 0, 0, 0
     for seed in range(20):
@@ -210,12 +215,9 @@ def test_the_kept_list_marks_what_the_whole_broad_phase_marks():
         assert not rebuilt
         whole = _candidates(packed, q, v, h, False)  # lines_in_reach at 0.5 h: γ h
         assert np.array_equal(marks, whole), seed
-        hn, ht = np.zeros((packed.n_contacts, 6)), np.zeros((packed.n_contacts, 6))
-        for i in range(packed.n_contacts):
-            gap, _ = contact_kinematics(packed.contacts, packed.contact_index, i, q, v, hn[i], ht[i])
-            if gap + gamma * h * row_dot(hn, packed.contact_index, i, v) <= ACTIVATION_ROUNDOFF:
-                activated += 1
-                assert marks[i] == 1, (seed, i)
+        for i in _activated(packed, q, v, h, gamma):
+            activated += 1
+            assert marks[i] == 1, (seed, i)
         in_reach += int(np.sum(whole))
         kept_total += n_kept
         listed_total += packed.pair_keys.shape[0] + 4 * 4
