@@ -1,0 +1,34 @@
+"""benchmarks/bench_two_contact_solve.py --quick runs and prints every toy and solver (timings are
+not asserted), and the problems it times are the toys' coupled pairs as a step makes them."""
+from pathlib import Path
+
+import numpy as np
+from scripts import load_script
+
+from nonsmooth_rod import toys
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _bench():
+    return load_script(ROOT / "benchmarks" / "bench_two_contact_solve.py")
+
+
+def test_quick_prints_every_toy_and_solver(capsys):
+    module = _bench()
+    assert module.main(["--quick"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert [(row[0], row[1]) for row in rows] == [(name, s) for name in module.TWO_CONTACTS for s in ("lemke", "pgs")]
+
+
+def test_a_flat_blocks_pair_is_statically_indeterminate():
+    """Two corners of one rigid body: 4 contact rows on 3 degrees of freedom, so W = H M⁻¹ Hᵀ has
+    rank 3 (both corners share one slip velocity): where such a pair sticks, its split of the
+    tangential impulse is not unique (docs/solvers.md), so no closed form can rest on W > 0."""
+    Ws, qs, los, his = _bench().two_contact_problems(toys.BlockOnIncline())
+    assert len(Ws) > 10 and Ws.shape[1:] == (4, 4)
+    for W in Ws:
+        eigenvalues = np.linalg.eigvalsh(W)
+        assert eigenvalues[0] <= 1e-12 * eigenvalues[-1] and eigenvalues[1] > 1e-3 * eigenvalues[-1]
+        np.testing.assert_allclose(W[1], W[3], rtol=0, atol=1e-12 * np.abs(W).max())  # one slip velocity
+    assert np.all(los <= his)
