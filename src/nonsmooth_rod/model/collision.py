@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..validation import InputError, require_nonnegative, require_point, require_positive
+from ..validation import InputError, require_point, require_positive
 from .contacts import DiskOnDisk, DiskOnLine, DiskOnSegment, Line, Segment, SegmentEndOnEdge, VertexOnEdge
 from .laws import ContactLaw
 
