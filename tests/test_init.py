@@ -57,3 +57,33 @@ def test_numba_loads_on_first_use_and_the_package_then_calls_its_dispatchers():
     if not _run("from nonsmooth_rod import _jit; print(_jit.ENABLED)") == "True":
         pytest.skip("numba disabled")
     assert _run(code) == "ok"
+
+
+def test_threads_loading_numba_at_once_load_it_once():
+    """Two threads' first compiled calls at the same moment: numba is loaded once, and both see
+    every kernel as its one dispatcher (each LazyKernel's dispatcher made once)."""
+    pytest.importorskip("numba")
+    if not _run("from nonsmooth_rod import _jit; print(_jit.ENABLED)") == "True":
+        pytest.skip("numba disabled")
+    code = (
+        "import threading\n"
+        "from nonsmooth_rod import _jit\n"
+        "from nonsmooth_rod.integrators import moreau_jean_loop as loop\n"
+        "lazy = loop.run_steps\n"
+        "made = []\n"
+        "real = _jit._load_numba\n"
+        "def counted():\n"
+        "    made.append(1)\n"
+        "    return real()\n"
+        "_jit._load_numba = counted\n"
+        "barrier = threading.Barrier(4)\n"
+        "seen = []\n"
+        "def first_use():\n"
+        "    barrier.wait()\n"
+        "    seen.append(lazy.materialized())\n"
+        "threads = [threading.Thread(target=first_use) for _ in range(4)]\n"
+        "[t.start() for t in threads]; [t.join() for t in threads]\n"
+        "assert len(made) == 1 and len(seen) == 4 and all(d is loop.run_steps for d in seen), (made, seen)\n"
+        "print('ok')\n"
+    )
+    assert _run(code) == "ok"

@@ -40,6 +40,7 @@ _choose_cache_dir()
 
 import importlib.util
 import sys
+import threading
 
 # numba is the optional `fast` extra. It is imported on the first compiled call, not by the
 # decorators: `import nonsmooth_rod` stays light (numba, llvmlite, yaml and scipy cost ~0.2 s of
@@ -111,6 +112,7 @@ def jitable(function):
 _numba = None  # the numba module once loaded
 _pending_jitable: list = []  # jitable functions to register with numba when it loads
 _lazy_kernels: list = []  # LazyKernels made before numba loaded
+_load_lock = threading.Lock()
 
 
 class LazyKernel:
@@ -170,6 +172,12 @@ def load_numba():
     global _numba
     if _numba is not None:
         return _numba
+    with _load_lock:  # two threads' first compiled calls at once: one loads, the other finds it loaded
+        return _numba if _numba is not None else _load_numba()
+
+
+def _load_numba():
+    global _numba
     import numba
     import numba.extending
 

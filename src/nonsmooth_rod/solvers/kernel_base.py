@@ -60,19 +60,22 @@ def step_residual(W, q, lo, hi, p, u):
 
 @jit_borrowing
 def contact_residual(lo, hi, p, u):
-    """max over contacts of |min(p_N, u_N)| and |p_T − proj_[lo p_N⁺, hi p_N⁺](p_T − u_T)|."""
+    """max over contacts of one_contact_residual."""
     residual = 0.0
     for i in range(lo.shape[0]):
-        p_n = p[2 * i]
-        p_t = p[2 * i + 1]
-        r_n = abs(min(p_n, u[2 * i]))
-        p_n_pos = max(p_n, 0.0)
-        trial = p_t - u[2 * i + 1]
-        low = lo[i] * p_n_pos
-        high = hi[i] * p_n_pos
-        projected = low if trial < low else (high if trial > high else trial)
-        residual = max(residual, r_n, abs(p_t - projected))
+        residual = max(residual, one_contact_residual(lo[i], hi[i], p[2 * i], p[2 * i + 1], u[2 * i], u[2 * i + 1]))
     return residual
+
+
+@jit_borrowing
+def one_contact_residual(lo, hi, p_n, p_t, u_n, u_t):
+    """max(|min(p_N, u_N)|, |p_T − proj_[lo p_N⁺, hi p_N⁺](p_T − u_T)|): one contact's distance from the law."""
+    p_n_pos = max(p_n, 0.0)
+    trial = p_t - u_t
+    low = lo * p_n_pos
+    high = hi * p_n_pos
+    projected = low if trial < low else (high if trial > high else trial)
+    return max(abs(min(p_n, u_n)), abs(p_t - projected))
 
 
 @jit_borrowing

@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 
 from .._jit import jit_borrowing
-from .kernel_base import DEFAULT_RTOL
+from .kernel_base import DEFAULT_RTOL, one_contact_residual
 
 # Relative margins of the conditions above: closer to them the problem is left to the solver
 # (its answer there may be one of several, or ill-conditioned).
@@ -61,8 +61,6 @@ def one_contact_impulse(a, b_nt, b_tn, c, q_n, q_t, lo, hi):
     return True, (x - b_nt * p_t) / a, p_t
 
 
-
-
 @jit_borrowing
 def one_contact_into(W, blocks, q, lo, hi, p, u):
     """p, u = W p + q of a one-contact problem in closed form (one_contact_impulse) — W dense
@@ -81,11 +79,7 @@ def one_contact_into(W, blocks, q, lo, hi, p, u):
     if not found:
         return -1.0
     u_n, u_t = a * p_n + b_nt * p_t + q[0], b_tn * p_n + c * p_t + q[1]
-    # contact_residual's formula for one contact
-    low, high = lo[0] * p_n, hi[0] * p_n
-    trial = p_t - u_t
-    projected = low if trial < low else (high if trial > high else trial)
-    residual = max(abs(min(p_n, u_n)), abs(p_t - projected))
+    residual = one_contact_residual(lo[0], hi[0], p_n, p_t, u_n, u_t)
     scale = max(abs(q[0]), abs(q[1]), abs(p_n), abs(p_t), abs(u_n), abs(u_t))
     if residual > DEFAULT_RTOL * (scale if scale > 0.0 else 1.0):
         return -1.0
