@@ -140,6 +140,10 @@ BAD = [
     ("simulation.stop", '["floor", "floor"]', "simulation.stop: one contact at a time"),
     ("simulation.moreau-jean.h", "1e-4", "simulation.h: given twice: also as simulation.moreau-jean.h"),
     ("simulation.event-driven.h", "1e-4", "simulation.event-driven.h: unknown key"),
+    # another method's table is checked by value too: --set simulation.method=… would run it
+    ("simulation.event-driven.rtol", "-1", "simulation.event-driven: rtol must lie in"),
+    ("simulation.event-driven.rtol", "nan", "simulation.event-driven.rtol: must be finite"),
+    ("simulation.hybrid.h", "0", "simulation.hybrid: h (step size) must lie in"),
     ("schema", '"nonsmooth-rod/scene/9"', "schema: must be 'nonsmooth-rod/scene/1'"),
     ("gravity", "inf", "gravity: must be finite"),
     ("title", "1979-05-27", "title: must be a number, string, list or table, got datetime.date"),

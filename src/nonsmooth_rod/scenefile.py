@@ -679,7 +679,23 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list, float |
     stop = _stop(w, sim, contact_names)
     options = _method_options(w, sim, method)
     _check_options(w, _options_class(method), options, stop)
+    _check_other_methods(w, sim, method)
     return method, t_end, options, stop, save_every
+
+
+def _check_other_methods(w, sim: dict, method: str) -> None:
+    """The values of the other methods' tables too: a file whose [simulation.event-driven] holds
+    rtol = -1 is wrong whichever method runs it now (`--set simulation.method=…` switches later)."""
+    flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop", "save_every") and k not in METHODS}
+    for name in METHODS:
+        if name == method or not isinstance(sim.get(name), dict):
+            continue
+        allowed = _allowed_options(name)
+        table = {**{k: v for k, v in flat.items() if k in allowed}, **sim[name]}
+        for key, value in sim[name].items():
+            if isinstance(value, float) and not math.isfinite(value):
+                raise w.error(f"simulation.{name}.{key}", f"must be finite, got {quoted(value)}")
+        _check_options(w, _options_class(name), table, [], where=f"simulation.{name}")
 
 
 def _stop(w, sim: dict, contact_names) -> list:
@@ -700,7 +716,7 @@ def _allowed_options(method: str) -> list:
 
 def _method_options(w, sim: dict, method: str) -> dict:
     """Options of the chosen method: [simulation.<method>] over the flat keys of [simulation].
-    Tables of the other methods are checked for their key names only, so that
+    The other methods' tables are checked too (_check_other_methods), so that
     `--set simulation.method=event-driven` switches to options the file already holds."""
     flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop", "save_every") and k not in METHODS}
     _check_keys(w, flat, _allowed_options(method) + list(METHODS), "simulation")
@@ -717,14 +733,14 @@ def _method_options(w, sim: dict, method: str) -> dict:
     return {**flat, **own}
 
 
-def _check_options(w, cls, options: dict, stop: list) -> None:
+def _check_options(w, cls, options: dict, stop: list, where: str = "simulation") -> None:
     """Build the method's options once so a bad value is refused here, naming the key."""
     try:
         cls(**options, stop_at_impact=stop[0] if stop else None)
     except InputError as err:
-        raise w.error("simulation", str(err)) from None
+        raise w.error(where, str(err)) from None
     except (TypeError, ValueError) as err:
-        raise w.error("simulation", f"bad option value: {err}") from None
+        raise w.error(where, f"bad option value: {err}") from None
 
 
 # --- overrides: --set contacts.floor.law.mu_s=0.3 ------------------------------------------------
