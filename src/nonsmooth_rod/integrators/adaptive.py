@@ -230,7 +230,7 @@ class Controller:
         return True
 
     def refuse(self, H: float) -> None:
-        """An attempt refused whatever its estimate (its held contacts did not stick): redone in halves."""
+        """An attempt refused whatever its estimate (a held contact ended it open): redone in halves."""
         self._retry(H, 0.5)
 
     def _retry(self, H: float, factor: float) -> bool:
