@@ -118,3 +118,23 @@ def test_rocking_block_impacts_at_housners_ratio():
     for k, (t, before, after) in enumerate(pairs):
         assert abs(t - ref_times[k]) <= 1e-6
         assert abs(abs(after / before) - toy.ratio) <= 1e-6
+
+
+@pytest.mark.parametrize("delta", [1e-6, -1e-6])
+def test_first_event_predicts_the_grazing_break_away(delta):
+    """Hybrid.first_event (what error-controlled Moreau–Jean plans its windows on) from the
+    rod's start in its rolling modes: the reference's first break-away within 1e-7 s (below the
+    peak, δ < 0, T/N meets μs at a slope ~ √δ: the hybrid method's steps of 1e-2 s measured 6e-8 s
+    there; above it, 1e-8), with δ = +1e-6 the one after rolling through the peak."""
+    from nonsmooth_rod.integrators.hybrid import Hybrid, HybridOptions
+
+    peak = rolling_hypothesis(RodProblem.paper(None, mu_s=0.3, mu_d=0.2)).T_over_N_max
+    problem = RodProblem.paper(None, mu_s=peak + delta, mu_d=0.2)
+    reference = simulate_rod(problem, "event-driven")
+    q0, v0 = problem.initial_state()
+    first = reference.phases[0].t_end
+    predicted = Hybrid(HybridOptions(h=1e-2)).first_event(problem.scene(), 0.0, q0, v0, ["stick", "open"], 0.5)
+    assert predicted[1].startswith("break") and predicted[2] == 0
+    assert abs(predicted[0] - first) <= 1e-7
+    if delta > 0:
+        assert first > 0.2  # rolls through the peak at 0.158 s

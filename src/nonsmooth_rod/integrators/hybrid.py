@@ -228,6 +228,21 @@ def _first_step_cap(boundaries: list) -> float:
     return GROWTH * (boundaries[-1] - boundaries[-2]) if len(boundaries) > 1 else math.inf
 
 
+@dataclass
+class _Counts:
+    """What a run counts of a prediction's steps (first_event), not kept."""
+
+    steps: int = 0
+    nfev: int = 0
+
+
+def handles(scene) -> bool:
+    """Whether the hybrid method runs this scene: its contacts and no refusal of its declaration."""
+    declared = Hybrid.declares
+    return (all(type(c).__name__ in declared.contacts for c in scene.contacts)
+            and all(r.finds(scene) is None for r in declared.refusals))
+
+
 class Hybrid(EventDriven):
     """Fixed explicit Runge–Kutta steps in each smooth mode, the reference's events between them
     (disks and points on lines)."""
@@ -270,32 +285,53 @@ class Hybrid(EventDriven):
         mode = _Mode(scene, modes, indicators, self._system)
         start = _Stage(mode, run.t, np.concatenate([run.q, run.v]))
         watch = _StepWatch(mode, start)
-        s_start, h = watch.values(start), self.options.h
         if not run.samples and run.unkept is None:  # the run's first state (later segments start at a sample)
             run.sample(start.t, start.y, modes, start.dynamics())
-        cap = _first_step_cap(run.boundaries)
         try:
-            while True:
-                step = min(h, cap, t_end - start.t)
-                if t_end - start.t < 1.01 * step:
-                    step = t_end - start.t  # no sliver of a last step
-                cap *= GROWTH
-                middle, end = self._step(mode, start, step, run)
-                run.steps += 1
-                dense = _hermite(start, end)
-                ts = (start.t, middle.t, end.t)
-                hit = watch.first_event_sampled(dense, ts, np.array([s_start, watch.values(middle),
-                                                                     s_end := watch.values(end)]))
-                if hit is not None:
-                    run.close(float(hit[0]), dense(hit[0]), modes)
-                    return indicators[hit[1]].kind, indicators[hit[1]].contact
-                if end.t >= t_end:
-                    run.close(float(end.t), end.y, modes, end.dynamics())
-                    return None
-                run.sample(end.t, end.y, modes, end.dynamics())
-                start, s_start = end, s_end
+            hit, dense, end = self._watched_steps(mode, start, watch, t_end, _first_step_cap(run.boundaries), run,
+                                                  lambda stage: run.sample(stage.t, stage.y, modes, stage.dynamics()))
         finally:
             run.indicator_evaluations += watch.evaluations
+        if hit is None:
+            run.close(float(end.t), end.y, modes, end.dynamics())
+            return None
+        run.close(float(hit[0]), dense(hit[0]), modes)
+        return indicators[hit[1]].kind, indicators[hit[1]].contact
+
+    def _watched_steps(self, mode: _Mode, start: _Stage, watch: _StepWatch, t_end: float, cap: float, counts,
+                       on_step):
+        """Steps of h (the first at most `cap`, then growing by GROWTH) from `start` until the
+        watch's first event or t_end: (the event (t, indicator index) or None, the last step's
+        interpolant, its end stage). on_step(end) is called at every other step's end; counts
+        (a run) counts the steps and the mode solves."""
+        s_start, h = watch.values(start), self.options.h
+        while True:
+            step = min(h, cap, t_end - start.t)
+            if t_end - start.t < 1.01 * step:
+                step = t_end - start.t  # no sliver of a last step
+            cap *= GROWTH
+            middle, end = self._step(mode, start, step, counts)
+            counts.steps += 1
+            dense = _hermite(start, end)
+            ts = (start.t, middle.t, end.t)
+            hit = watch.first_event_sampled(dense, ts, np.array([s_start, watch.values(middle),
+                                                                 s_end := watch.values(end)]))
+            if hit is not None or end.t >= t_end:
+                return hit, dense, end
+            on_step(end)
+            start, s_start = end, s_end
+
+    def first_event(self, scene, t: float, q, v, modes, t_end: float):
+        """The first event of the smooth phase in `modes` from (t, q, v) before t_end, as this
+        method finds it (its steps, its watch, the reference's indicators): (t_event, kind,
+        contact), or None. Error-controlled Moreau–Jean decides break-aways by it
+        (integrators/adaptive_breakaway.py)."""
+        indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, t, q, v))
+        mode = _Mode(scene, modes, indicators, self._system)
+        start = _Stage(mode, t, np.concatenate([q, v]))
+        hit, _, _ = self._watched_steps(mode, start, _StepWatch(mode, start), t_end, math.inf, _Counts(),
+                                        lambda stage: None)
+        return None if hit is None else (float(hit[0]), indicators[hit[1]].kind, indicators[hit[1]].contact)
 
     def _step(self, mode: _Mode, start: _Stage, h: float, run):
         """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""
