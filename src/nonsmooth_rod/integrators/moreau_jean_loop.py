@@ -1301,10 +1301,11 @@ def _fixed_period(k, steps_here, q, v, p_normal, p_tangent, memory):
             if q[k + 1, d] != q[k + 1 - period, d] or v[k + 1, d] != v[k + 1 - period, d]:
                 same = False
                 break
-        for i in range(p_normal.shape[1] if same else 0):
-            if p_normal[k, i] != p_normal[k - period, i] or p_tangent[k, i] != p_tangent[k - period, i]:
+        for c in range(p_normal.shape[1] if same else 0):  # the records' columns (new_records)
+            if p_normal[k, c] != p_normal[k - period, c] or p_tangent[k, c] != p_tangent[k - period, c]:
                 same = False
                 break
+        for i in range(memory.shape[2] if same else 0):  # every contact's memory
             for m in range(3):
                 if memory[k % 3, m, i] != memory[(k - period) % 3, m, i]:
                     same = False

@@ -32,7 +32,8 @@ from .sampling import save_slots
 # Rows of records a window keeps from the steps before its first: the warm start reads one, the
 # location of a phase boundary at step k reads steps k − 4 … k − 1 (moreau_jean._boundary_offset).
 HISTORY = 4
-# The largest window (steps): its rows cost 16 n_dof + 32 n_contacts bytes a step.
+# The largest window (steps): its rows cost 16 n_dof + 32 bytes a step per record column (at most
+# n_contacts: moreau_jean_loop.new_records).
 MAX_CHUNK = 1 << 16
 # Work arrays of moreau_jean_loop that carry a contact's memory from one step to the next.
 WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
