@@ -14,10 +14,10 @@ So memory follows what is kept, not the number of steps, and a stop condition ca
 between windows. The window's per-contact records have a column only for the contacts that have
 been candidates (moreau_jean_loop.new_records: found contacts list hundreds that never come
 near); what is taken from them is every contact's (`Window.full`), those without a column
-holding the records of a contact out of reach. `ResumeState` is what the next step reads from the steps before it — q, v,
-the contact memory (closed, grazing, slip signs) and the last HISTORY rows of records (warm
-starts, phase location) — with the step grid (origin, index): a restart continues the very
-same floats.
+holding the records of a contact out of reach. `ResumeState` is what the next step reads from
+the steps before it — q, v, the contact memory (closed, grazing, slip signs) and the last
+HISTORY rows of records (warm starts, phase location) — with the step grid (origin, index): a
+restart continues the very same floats.
 """
 from __future__ import annotations
 
