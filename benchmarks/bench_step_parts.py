@@ -9,8 +9,9 @@ compiled loop of its own (numba; CPU time per call, median of --rounds, the scen
 broad_candidates on its kept list, built by the first call — the tower at rest never rebuilds
 it; the declared tower's step runs none — too few disk pairs — so its column is the test alone),
 `solve` (assemble and the two-coefficient Lemke solve),
-`finish` (end velocity and state, every contact's records — rows cycled over a window of 4000 steps,
-as a run writes them —, impacts, memory), `finish 1 row` (the same on one row: the records' memory
+`finish` (end velocity and state, the records of the contacts with a column — the candidates so
+far, moreau_jean_loop.new_records —, rows cycled over a window of 4000 steps as a run writes them,
+impacts, memory), `finish 1 row` (the same on one row: the records' memory
 traffic is the difference) and `after` (the rest's ring), then the whole loop for 4000 steps from
 that state (`run`, per step; the rest is not repeated). Prints the parts side by side and their
 differences from the declared tower. Needs numba (its harness compiles in ~10 s, not cached:
@@ -31,7 +32,7 @@ import bench_shapes  # noqa: E402
 
 from nonsmooth_rod.integrators import moreau_jean as mj  # noqa: E402
 from nonsmooth_rod.integrators import moreau_jean_loop as L  # noqa: E402
-from nonsmooth_rod.integrators.moreau_jean_records import Grid, Window  # noqa: E402
+from nonsmooth_rod.integrators.moreau_jean_records import Grid  # noqa: E402
 from nonsmooth_rod.integrators.scene_plans import scene_plan  # noqa: E402
 
 WARM_STEPS, RUN_STEPS, FINISH_ROWS = 1000, 4000, 4000
@@ -48,7 +49,7 @@ def _harness():
             na = L.begin_arrays(params, o.q[k], o.v[k], f, m.minv, m.contacts, m.contact_index, m.disks, m.disk_body,
                                 m.pair_keys, m.pair_contact, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht,
                                 w.active, w.was_closed, w.v_free, w.a_free, w.candidate, s.floats, s.kept,
-                                s.kept_pose)
+                                s.kept_pose, k, o)
         return na
 
     @numba.njit
@@ -68,8 +69,7 @@ def _harness():
             status = L.solve_arrays(iparams[L.I_SOLVER], k, params, iparams, na, o.q[k], o.v[k], m.minv, m.contacts,
                                     m.contact_index, m.joints, w.joint_buffer, w.gaps, w.hn, w.ht, w.active,
                                     w.was_closed, w.grazing, w.slip_sign, w.v_free, o.p_normal, o.p_tangent,
-                                    o.counters, s.floats, s.W, s.solver_floats, s.solver_ints, s.sparse_ints,
-                                    s.sparse_floats, p, u, states)
+                                    o.column, o.counters, s, p, u, states)
         return status
 
     @numba.njit
@@ -79,9 +79,7 @@ def _harness():
         for r in range(reps):
             L.finish_arrays(r % rows, params, iparams, na, p, u, states, qk, vk, m.minv, m.contacts,
                             m.contact_index, m.pair_keys, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht,
-                            w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o.q,
-                            o.v, o.p_normal, o.p_tangent, o.slip, o.states, o.impact_t, o.impact_step,
-                            o.impact_contact, o.counters, o.joint_impulse)
+                            w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o)
         return 0
 
     @numba.njit
@@ -99,7 +97,7 @@ def at_rest(scene, q0):
     grid = Grid.of(1e-3, 0.0, 10.0, None)
     plan = scene_plan(scene)
     model, work, v0 = mj._run_data(plan, q0, np.zeros_like(q0), grid, None)
-    window = Window(scene.n_dof, len(plan.names), WARM_STEPS + RUN_STEPS + 8)
+    window = mj._window(plan, scene.n_dof, len(plan.names), WARM_STEPS + RUN_STEPS + 8, 0)  # the run's columns
     window.seed(q0, v0, 0, None)
     params, iparams = mj.MoreauJean(mj.MoreauJeanOptions(h=1e-3))._parameters(scene, grid, list(plan.names))
     iparams[L.I_TIME_INVARIANT] = 0

@@ -1,5 +1,6 @@
 """The compiled loop's per-run scratch: a pgs step allocates nothing, and a dense W larger than the
-scratch is grown between steps (moreau_jean_loop.step_scratch, RUN_SCRATCH_SHORT)."""
+scratch is grown between steps (moreau_jean_loop.step_scratch, RUN_SCRATCH_SHORT); the rest check
+reads every contact's memory."""
 import numpy as np
 import pytest
 
@@ -67,3 +68,18 @@ def test_a_pgs_step_allocates_nothing(case):
     finally:
         nrt_stats.memsys_disable_stats()
     assert counts[0] == counts[1], counts
+
+
+def test_a_rest_is_not_repeated_while_a_contact_without_a_record_column_changes_its_memory():
+    """The rest check (_fixed_period) compares every contact's memory (closed, grazing, slip sign),
+    not only the contacts with a column of the records (fewer than the contacts: new_records):
+    a state the step leaves unchanged but for one contact's memory is not a rest."""
+    from nonsmooth_rod.integrators.moreau_jean_loop import _fixed_period
+
+    k, n_contacts, columns = 5, 6, 2
+    q, v = np.ones((k + 2, 3)), np.zeros((k + 2, 3))
+    p_normal, p_tangent = np.full((k + 1, columns), 0.5), np.zeros((k + 1, columns))
+    memory = np.zeros((3, 3, n_contacts))
+    assert _fixed_period(k, k, q, v, p_normal, p_tangent, memory) == 1  # a rest: everything repeats
+    memory[k % 3, 1, n_contacts - 1] = 1.0  # the last contact starts grazing at step k
+    assert _fixed_period(k, k, q, v, p_normal, p_tangent, memory) == 0

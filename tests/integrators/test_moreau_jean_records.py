@@ -144,3 +144,188 @@ def test_small_windows_give_the_very_same_run(make, monkeypatch):
     windows = nr.simulate(scene, q0, v0, t_end, h=1e-3)
     assert_same_continuation(whole, windows, 0.0)
     assert len(whole.events) >= 2
+
+
+# --- records only for the contacts that come near (moreau_jean_loop.new_records) ----------------
+BOX_W, BOX_H = 0.4, 0.3
+
+
+def box_tower(n: int, found: bool):
+    """(scene, q0) of n boxes stacked on a floor (benchmarks/bench_shapes.py's tower): every pair of
+    shapes' candidate contacts found (32 a pair of boxes), or the 2n that touch declared by hand."""
+    bodies = [nr.RigidBody(1.0, (BOX_W ** 2 + BOX_H ** 2) / 12.0, name=f"box{k}") for k in range(n)]
+    law, floor, box = nr.ContactLaw.of(0.5, 0.4), nr.Line(), nr.Polygon.rectangle(BOX_W, BOX_H)
+    if found:
+        contacts = nr.find_contacts(bodies, {b.name: box for b in bodies}, {"floor": floor}, nr.PairLaws(default=law))
+    else:
+        contacts = [nr.PointOnLine(0, box.vertices[i], floor, law, name=f"box0.v{i}/floor") for i in (0, 1)]
+        contacts += [nr.VertexOnEdge(k, box.vertices[i], k - 1, *box.edge(2), cone=box.cone(i), law=law,
+                                     name=f"box{k}.v{i}/box{k - 1}.e2") for k in range(1, n) for i in (0, 1)]
+    q0 = np.zeros(3 * n)
+    q0[1::3] = BOX_H / 2 + BOX_H * np.arange(n)
+    return nr.Scene(bodies, contacts), q0
+
+
+def windows_of_runs(monkeypatch):
+    """The windows the runs make from now on (moreau_jean._window wrapped), each with the records it
+    started with (`window.first_out`: lent or new; widening replaces `window.out`)."""
+    from nonsmooth_rod.integrators import moreau_jean
+
+    made, make = [], moreau_jean._window
+
+    def window(*args):
+        made.append(make(*args))
+        made[-1].first_out = made[-1].out
+        return made[-1]
+
+    monkeypatch.setattr(moreau_jean, "_window", window)
+    return made
+
+
+def same_bits(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype == object:
+        return a.shape == b.shape and np.array_equal(a, b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def assert_same_run(got, want):
+    """The same run bit for bit: samples, modes, phases, events, impacts, end state."""
+    for name in ("t", "q", "v", "normal_force", "tangential_force", "modes"):
+        assert same_bits(getattr(got, name), getattr(want, name)), name
+    assert got.phases == want.phases and got.events == want.events
+    assert len(got.impacts) == len(want.impacts)
+    for a, b in zip(got.impacts, want.impacts):
+        assert (a.t, a.contact) == (b.t, b.contact)
+        for name in ("q", "v_before", "v_after", "normal_impulse", "tangential_impulse"):
+            assert same_bits(getattr(a, name), getattr(b, name)), name
+    assert (got.end_state is None) == (want.end_state is None)
+    if want.end_state is not None:
+        assert got.end_state.as_dict() == want.end_state.as_dict()
+        assert same_bits(got.end_state.slip, want.end_state.slip)  # (-0.0 is not 0.0)
+    assert (got.status, got.message, got.steps) == (want.status, want.message, want.steps)
+
+
+def test_found_contacts_that_never_come_near_have_no_records_yet_report_what_the_declared_run_does(monkeypatch):
+    """A tower of 5 boxes at rest: of its 340 found contacts only the candidates get record columns,
+    and the run reports the declared tower's forces, modes and phases on the 10 that touch and an
+    open contact without force on every other one."""
+    made = windows_of_runs(monkeypatch)
+    found, q0 = box_tower(5, True)
+    declared, _ = box_tower(5, False)
+    run = nr.simulate(found, q0, np.zeros_like(q0), 0.3, h=1e-3)
+    reference = nr.simulate(declared, q0, np.zeros_like(q0), 0.3, h=1e-3)
+    window = made[0]
+    contacts, _, _ = window.columns()
+    assert 10 <= contacts.size <= 40 and window.out.p_normal.shape[1] <= 40  # not 340
+    np.testing.assert_allclose(run.q, reference.q, rtol=0, atol=1e-12)
+    names = [c.name for c in found.contacts]
+    touching = [names.index(c.name) for c in declared.contacts]
+    assert set(touching) <= set(contacts.tolist())
+    scale = 5 * 9.81
+    np.testing.assert_allclose(run.normal_force[:, touching], reference.normal_force, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(run.tangential_force[:, touching], reference.tangential_force, atol=1e-9 * scale)
+    assert run.modes[:, touching].tolist() == reference.modes.tolist()
+    others = np.setdiff1d(np.arange(len(names)), touching)
+    assert not run.normal_force[:, others].any() and not run.tangential_force[:, others].any()
+    assert set(run.modes[:, others].ravel()) == {"open"}
+    assert all([(p.mode, p.t_start, p.t_end) for p in run.phases[names[i]]] == [("open", 0.0, 0.3)] for i in others)
+    for name in declared.contacts:
+        assert [(p.mode, p.t_start, p.t_end) for p in run.phases[name.name]] == \
+            [(p.mode, p.t_start, p.t_end) for p in reference.phases[name.name]]
+    end = run.end_state
+    assert not end.p_normal[:, others].any() and not end.states[:, others].any()
+    assert np.all(np.signbit(end.slip[:, np.setdiff1d(others, contacts)]))  # −0.0, as a contact out of reach's
+
+
+def pushed_tower():
+    """The found tower with its top box thrown sideways and the bottom one pushed: boxes slide,
+    tip and land on one another (new candidates all along, impacts, phases)."""
+    scene, q0 = box_tower(4, True)
+    v0 = np.zeros_like(q0)
+    v0[0], v0[9], v0[11] = 0.4, -1.5, 3.0
+    return scene, q0, v0
+
+
+@pytest.mark.parametrize("options", [{}, {"save_every": 0.01}, {"solver": "pgs"}])
+def test_records_widened_from_one_column_give_the_very_same_run(options, monkeypatch):
+    """Records that start with one column, widened each time a new candidate finds them full (the
+    step run again from its start), give the run of records wide enough from the start."""
+    from nonsmooth_rod.integrators import moreau_jean
+
+    scene, q0, v0 = pushed_tower()
+    made = windows_of_runs(monkeypatch)
+    wide = nr.simulate(scene, q0, v0, 0.4, h=1e-3, **options)
+    monkeypatch.setattr(moreau_jean, "RECORD_COLUMNS_PER_BODY", 0)
+    monkeypatch.setattr(moreau_jean, "MIN_RECORD_COLUMNS", 1)
+    narrow = nr.simulate(scene, q0, v0, 0.4, h=1e-3, **options)
+    assert made[0].out.p_normal.shape[1] >= made[1].columns()[0].size > 1  # widened, and as many given
+    assert made[1].out.p_normal.shape[1] < len(scene.contacts)
+    assert_same_run(narrow, wide)
+    assert len(wide.impacts) >= 1 and sum(len(p) > 1 for p in wide.phases.values()) >= 3
+
+
+def test_a_stopped_and_a_resumed_run_with_few_columns_go_on_as_the_whole_run(monkeypatch):
+    """A stop condition's replay and a restart from an end state keep each contact's records in
+    its column (the restart gives columns to the contacts whose history has records)."""
+    from nonsmooth_rod.integrators import moreau_jean
+
+    scene, q0, v0 = pushed_tower()
+    whole = nr.simulate(scene, q0, v0, 0.4, h=1e-3)
+    monkeypatch.setattr(moreau_jean, "RECORD_COLUMNS_PER_BODY", 0)
+    monkeypatch.setattr(moreau_jean, "MIN_RECORD_COLUMNS", 2)
+    stopped = nr.simulate(scene, q0, v0, 0.4, h=1e-3, stop=lambda t, q, v: t >= 0.2)
+    assert stopped.status == "stopped"
+    again = nr.simulate(scene, stopped.q[-1], stopped.v[-1], 0.4, h=1e-3, t0=stopped.t[-1],
+                        resume=stopped.end_state)
+    assert_same_continuation(whole, again, float(stopped.t[-1]))
+    assert again.end_state.as_dict() == whole.end_state.as_dict()
+
+
+def test_records_lent_to_the_next_run_keep_no_column_of_the_last(monkeypatch):
+    """A short run's window records, lent to the scene's next run (integrators/scene_plans.py),
+    come back without the last run's columns or values: a run from another state, whose
+    candidates are other contacts, is the fresh run bit for bit."""
+    from nonsmooth_rod.integrators import moreau_jean
+    from nonsmooth_rod.integrators.scene_plans import forget_plans
+
+    scene, q0, v0 = pushed_tower()
+    made = windows_of_runs(monkeypatch)
+    monkeypatch.setattr(moreau_jean, "RECORD_COLUMNS_PER_BODY", 20)  # never widened: the lent set is the run's
+    forget_plans()
+    nr.simulate(scene, q0, v0, 0.05, h=1e-3)  # lends its records (a short window)
+    first = made[0].columns()[0].copy()
+    q1, v1 = q0.copy(), -v0
+    q1[0::3] += 0.05 * np.arange(4)  # a leaning stack: other corners near
+    lent = nr.simulate(scene, q1, v1, 0.05, h=1e-3)
+    assert made[1].first_out is made[0].out and made[1].out is made[0].out  # the same records, lent
+    forget_plans()
+    fresh = nr.simulate(scene, q1, v1, 0.05, h=1e-3)
+    assert made[2].out is not made[0].out
+    assert made[1].columns()[0].tolist() == made[2].columns()[0].tolist() != first.tolist()  # other candidates
+    assert_same_run(lent, fresh)
+
+
+def test_the_records_of_a_long_found_run_take_memory_by_the_contacts_that_come_near(monkeypatch):
+    """20 000 steps of the found tower at rest (one window): its records take the columns of the
+    few dozen candidates, not the 340 listed contacts' (218 MB); tracemalloc's peak of the run."""
+    import tracemalloc
+
+    made = windows_of_runs(monkeypatch)
+    scene, q0 = box_tower(5, True)
+    nr.simulate(scene, q0, np.zeros_like(q0), 0.01, h=1e-3)  # warm: packed, compiled
+    steps = 20_000
+    tracemalloc.start()
+    try:
+        nr.simulate(scene, q0, np.zeros_like(q0), steps * 1e-3, h=1e-3, save_every=0.1)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    window = made[-1]
+    given = window.columns()[0].size
+    assert given <= 40 and window.out.p_normal.shape[1] <= 2 * max(given, 20)
+    rows = steps + 4
+    records = rows * 8 * (2 * scene.n_dof + 4 * window.out.p_normal.shape[1])  # q, v and 4 records a column
+    kept = 201 * len(scene.contacts) * (8 + 8 + 1 + 8)  # the result's samples: N, T, codes, modes
+    assert peak <= records + kept + (3 << 20), (peak, records)  # (+ the windows' temporaries)
+    assert peak < rows * 8 * 4 * len(scene.contacts) / 4  # (every listed contact's records: 218 MB)

@@ -27,7 +27,7 @@ import numpy as np
 from .. import _jit
 from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
-from ..model.packing import C_MU_S, pack_scene
+from ..model.packing import C_MU_S, C_SURFACE_VELOCITY, pack_scene
 from ..model.scene import Scene
 from ..results import Event, Impact, Phase, SimulationResult, Status, Trajectory, phases_from_intervals
 from ..solvers.registry import DEFAULT_SOLVER, EXACT_SOLVERS, SOLVER_CODES, SolverName, check_solver_options
@@ -188,9 +188,17 @@ def _run_data(plan, q0, v0, grid: Grid, resume):
 LENT_WINDOW_BYTES = 1 << 18
 
 
+# Record columns a window starts with, per body (at least MIN_RECORD_COLUMNS; at most one a
+# contact): a tower of 5 boxes has 36 candidates among its 340 found contacts; more widen it.
+RECORD_COLUMNS_PER_BODY, MIN_RECORD_COLUMNS = 8, 16
+
+
 def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> Window:
-    """The run's window: with the records an earlier run of the scene lent (zeroed), or new."""
-    return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk))
+    """The run's window: with the records an earlier run of the scene lent (zeroed), or new, with
+    a column of records for the contacts that are candidates (moreau_jean_loop.new_records)."""
+    columns = max(MIN_RECORD_COLUMNS, RECORD_COLUMNS_PER_BODY * (n_dof // 3))
+    return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk), columns,
+                  -plan.packed.contacts[:, C_SURFACE_VELOCITY])
 
 
 def _lend_window(plan, window: Window, holder=None) -> bool:
@@ -380,7 +388,7 @@ class MoreauJean:
 
     def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops):
         """Run the grid's steps window by window; returns (run status, global step the run ended at)."""
-        k, counters = grid.first, window.out[9]
+        k = grid.first
         if stops and stop_holds(stops, grid.time(k), window.out[0][window.r], window.out[1][window.r]):
             collector.take(window, k, k, final=True)
             return loop.RUN_STOPPED_BY_CONDITION, k
@@ -391,7 +399,7 @@ class MoreauJean:
             n = engine.steps(1 if last else min(window.room(), grid.first + grid.n_full - k))
             step_params = self._shortened(params, grid, window, k) if last else params
             params[loop.P_K0] = window.k_base
-            snapshot = ([w.copy() for w in work], counters.copy()) if stops else None
+            snapshot = ([w.copy() for w in work], window.out[9].copy()) if stops else None
             started = time.perf_counter()
             status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
             engine.measured(k_done - k, time.perf_counter() - started, grid.last - k_done, status)
@@ -400,7 +408,7 @@ class MoreauJean:
                 if k_hold < k_done:  # replay to the step where it holds: the end state is that step's
                     for w, saved in zip(work, snapshot[0]):
                         w[...] = saved
-                    counters[:] = snapshot[1]
+                    window.out[9][:] = snapshot[1]
                     window.r = k - window.k_base
                     self._advance(engine, scene, window, k_hold - k, step_params, iparams, model, work)
                 collector.take(window, k, k_hold, final=True)
@@ -421,17 +429,23 @@ class MoreauJean:
 
     def _advance(self, engine, scene, window, n, params, iparams, model, work):
         """n steps from the window's current row with the engine's kernels (compiled, or their
-        interpreted twins); returns (run status, global step reached)."""
-        out, r0 = window.out, window.r
-        counters = out[9]
-        counters[loop.K_DONE] = r0
+        interpreted twins), the window's records widened whenever a new candidate finds their
+        columns taken; returns (run status, global step reached)."""
+        r0 = r = window.r
+        window.out[9][loop.K_DONE] = r0
         kernels = engine.kernels
         with engine.compiling():
-            if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
-                status = kernels.run_steps(r0, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
-            else:
-                status = self._run_stepwise(kernels, scene, r0, r0 + n, params, iparams, model, work, out)
-        window.r = int(counters[loop.K_DONE])
+            while True:
+                out = window.out
+                if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
+                    status = kernels.run_steps(r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
+                else:
+                    status = self._run_stepwise(kernels, scene, r, r0 + n, params, iparams, model, work, out)
+                if status != loop.RUN_RECORDS_SHORT:
+                    break
+                window.widen()  # and step K_DONE again, from its start
+                r = int(window.out[9][loop.K_DONE])
+        window.r = int(window.out[9][loop.K_DONE])
         return int(status), window.k_base + window.r
 
     def _first_hold(self, stops, collector, window, k_from, k_to):
@@ -457,12 +471,15 @@ class MoreauJean:
                 t = params[loop.P_T0] + ((params[loop.P_K0] + k) + params[loop.P_THETA]) * params[loop.P_H]
                 extra[:] = scene.applied(t, q[k], v[k])
             if compiled:  # books the step itself (end_of_step)
-                if kernels.run_steps(k, k + 1, params, iparams, model, work, out, extra) != loop.RUN_OK:
-                    return counters[loop.K_STATUS]
+                status = kernels.run_steps(k, k + 1, params, iparams, model, work, out, extra)
+                if status != loop.RUN_OK:
+                    return status if status == loop.RUN_RECORDS_SHORT else counters[loop.K_STATUS]
                 continue
             kernels.step_force(k, params, model, out, f)
             f += extra
             status = self._python_solver_step(kernels, k, f, params, iparams, model, work, out)
+            if status == loop.RUN_RECORDS_SHORT:
+                return status  # (_advance widens the records and runs step k again)
             if kernels.end_of_step(k, status, counters) != loop.RUN_OK:
                 return counters[loop.K_STATUS]
         return loop.RUN_OK
@@ -472,7 +489,7 @@ class MoreauJean:
         solve_two_coefficient."""
         q, v, counters = out[0], out[1], out[9]
         kernels.drive_step(k, params, model)
-        na = kernels.begin_step(params, q[k], v[k], f, model, work)
+        na = kernels.begin_step(params, q[k], v[k], f, model, work, k, out)
         if na < 0:
             return loop.geometry_failure(na, model[2].shape[0], counters)
         kernels.hold_driven_velocities(model, work)
@@ -503,7 +520,7 @@ class MoreauJean:
         if status == loop.RUN_STOPPED:
             return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
         out = window.out
-        q, states, counters = out[0], out[5], out[9]
+        q, counters = out[0], out[9]
         t_end = float(grid.time(k_end))
         if status == loop.RUN_STOPPED_BY_CONDITION:
             return Status.STOPPED, stop_message(t_end), stop_event(t_end)
@@ -520,8 +537,9 @@ class MoreauJean:
             return Status.FAILED, (f"{name}: the disk is deeper than its radius at step {k}, t = {t_k:.9g} s: it "
                               f"passed through its obstacle within a step; use a smaller h than {grid.h:g} s"), None
         r = k - window.k_base
-        state_txt = _states_text(names, states[r - 1] if r else None)
-        closed = int(np.count_nonzero(states[r - 1] != STATE_OPEN)) if r else 0
+        states = window.full(5, r - 1) if r else None  # every contact's
+        state_txt = _states_text(names, states)
+        closed = int(np.count_nonzero(states != STATE_OPEN)) if r else 0
         if closed > q.shape[1]:  # (measured on the 50-box heap: no duplicate rows, not the pivot limit)
             state_txt += (f"; {closed} contacts closed on {q.shape[1]} degrees of freedom: a redundant, "
                           "degenerate step problem whose solution failed the solver's accuracy check")

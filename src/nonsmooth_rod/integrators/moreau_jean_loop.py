@@ -78,6 +78,9 @@ RUN_STOPPED_BY_CONDITION = 5
 # (never leaves _run) a step's dense W does not fit the per-run scratch: _run grows it and goes on
 # from that step (Scratch.need: the step, its active contacts)
 RUN_SCRATCH_SHORT = 7
+# (never leaves moreau_jean._advance) a contact became a candidate with every column of the records
+# taken (Records.column): the window widens its records and goes on from that step
+RUN_RECORDS_SHORT = 8
 # Slots of the int64 `counters` record.
 (K_DONE, K_STATUS, K_FAIL_STEP, K_N_IMPACTS, K_SOLVES, K_INCONSISTENT, K_ITERATIONS, K_SOLVER_STATUS,
  K_FAIL_CONTACT, K_FALLBACKS, K_REPEATED) = range(11)
@@ -115,6 +118,9 @@ M_JOINTS = 18
 WORK_JOINTS = 11
 # out: each step's joint impulses (rows × 2 per joint).
 O_JOINT_IMPULSE = 10
+# out: each contact's column of the per-contact records + 1 (0: none yet), and at [n_contacts] the
+# columns given (new_records, _open_column).
+O_COLUMN = 11
 # The loop's data, by name (as MuJoCo's mjModel / mjData): the packed scene (moreau_jean._model_and_work),
 # the contacts' per-step memory and scratch, and the run's records (moreau_jean_records.Window). The
 # step's functions take the arrays they use, unpacked once per run (run_arrays): a tuple of arrays
@@ -125,7 +131,7 @@ Model = namedtuple("Model", "minv weight contacts contact_index force_table forc
                    "driven_origin joints")
 Work = namedtuple("Work", "gaps drifts hn ht active was_closed grazing slip_sign v_free a_free candidate joint_buffer")
 Records = namedtuple("Records", "q v p_normal p_tangent slip states impact_t impact_step impact_contact counters "
-                     "joint_impulse")
+                     "joint_impulse column")
 # A step's temporaries (step_scratch), allocated once per call of the loop; need: the step and
 # active contacts a RUN_SCRATCH_SHORT asks room for.
 # kept, kept_pose: the broad phase's kept list (broad_candidates), rebuilt at each call's first step.
@@ -133,13 +139,43 @@ Scratch = namedtuple("Scratch", "floats states W solver_floats solver_ints spars
                      "kept_pose")
 
 
-def new_records(n_dof, n_contacts, rows, impacts, joint_rows):
+def new_records(n_dof, n_contacts, rows, impacts, joint_rows, columns=None):
     """Records of `rows` steps (rows + 1 states), room for `impacts` impacts, `joint_rows` joint
-    impulses a step: the one constructor of the loop's `out` (moreau_jean_records.Window, adaptive)."""
-    per_step, f, i = (rows, n_contacts), np.float64, np.int64  # one buffer a dtype (integrators/carved.py)
-    return Records(*carve_zeros((((rows + 1, n_dof), f), ((rows + 1, n_dof), f), (per_step, f), (per_step, f),
-                                 (per_step, f), (per_step, i), ((impacts,), f), ((impacts,), i), ((impacts,), i),
-                                 ((N_COUNTERS,), i), ((rows, joint_rows), f))))
+    impulses a step: the one constructor of the loop's `out` (moreau_jean_records.Window, adaptive).
+
+    The per-contact records (p_normal, p_tangent, slip, states) have a column per contact that has
+    been a candidate (its kinematics computed) since they were zeroed, given when it first is one
+    (_open_column; Records.column maps contacts to columns): `columns` of them, at most
+    n_contacts. None: every contact its own column in order, given now (the error control's
+    short windows). A contact without a column has the records of one out of reach: 0, 0, the
+    belt's −surface velocity, open — 340 found candidates of a tower of 5 boxes, 12 to 36 of
+    which ever come near, wrote 54 MB of such rows in a 5000-step run."""
+    width = n_contacts if columns is None else min(columns, n_contacts)
+    per_step, f, i = (rows, width), np.float64, np.int64  # one buffer a dtype (integrators/carved.py)
+    records = Records(*carve_zeros((((rows + 1, n_dof), f), ((rows + 1, n_dof), f), (per_step, f), (per_step, f),
+                                    (per_step, f), (per_step, i), ((impacts,), f), ((impacts,), i), ((impacts,), i),
+                                    ((N_COUNTERS,), i), ((rows, joint_rows), f), ((n_contacts + 1,), i))))
+    if columns is None:
+        records.column[:n_contacts] = np.arange(1, n_contacts + 1)
+        records.column[n_contacts] = n_contacts
+    return records
+
+
+@_inlined
+def _open_column(i, k, table, out):
+    """Give contact i, a candidate at step k for the first time since the records were zeroed, the
+    next column of the records (Records.column: its column + 1; at [n_contacts] the columns given),
+    its rows before k those of a contact out of reach (as finish_arrays wrote them for it before);
+    False when every column is taken (RUN_RECORDS_SHORT)."""
+    column, n_contacts = out.column, table.shape[0]
+    given = column[n_contacts]
+    if given == out.p_normal.shape[1]:
+        return False
+    column[i], column[n_contacts] = given + 1, given + 1
+    for r in range(k):
+        out.p_normal[r, given], out.p_tangent[r, given] = 0.0, 0.0
+        out.slip[r, given], out.states[r, given] = -table[i, C_SURFACE_VELOCITY], 0
+    return True
 
 
 @_inlined
@@ -536,27 +572,38 @@ def pass_through_depth(table, index, i):
 @jit
 def geometry_failure(na, n_contacts, counters):
     """The run status of begin_step's failure code na < 0 (−1 − i: contact i's normal undefined;
-    −1 − n_contacts − i: contact i passed through), the contact booked in the counters."""
+    −1 − n_contacts − i: contact i passed through), the contact booked in the counters;
+    RUN_RECORDS_SHORT for records_full(n_contacts) (no column left for a new candidate)."""
     code = -1 - na
+    if code >= 2 * n_contacts:
+        return RUN_RECORDS_SHORT
     counters[K_FAIL_CONTACT] = code % n_contacts
     return RUN_BAD_GEOMETRY if code < n_contacts else RUN_PASSED_THROUGH
 
 
 @jit
-def begin_step(params, qk, vk, f, model, work):
-    """begin_arrays on the model and work tuples (the step-wise loop's entry)."""
+def begin_step(params, qk, vk, f, model, work, k, out):
+    """begin_arrays of step k on the model, work and out tuples (the step-wise loop's entry)."""
     return begin_arrays(params, qk, vk, f, model.minv, model.contacts, model.contact_index, model.disks,
                         model.disk_body, model.pair_keys, model.pair_contact, model.joints, work.joint_buffer,
                         work.gaps, work.drifts, work.hn, work.ht, work.active, work.was_closed, work.v_free,
-                        work.a_free, work.candidate, np.empty(0), np.empty(0, dtype=np.int64), np.empty(0))
+                        work.a_free, work.candidate, np.empty(0), np.empty(0, dtype=np.int64), np.empty(0), k, out)
+
+
+@_inlined
+def records_full(n_contacts):
+    """begin_arrays' code when a candidate finds every column of the records taken (geometry_failure
+    reads it as RUN_RECORDS_SHORT): below every geometry failure's."""
+    return -1 - 2 * n_contacts
 
 
 @_inlined
 def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_keys, pair_contact, joints,
                  joint_buffer, gaps, drifts, hn, ht, active, was_closed, v_free, a_free, candidate, room, kept,
-                 kept_pose):
-    """Free velocity, contact kinematics and the active set; returns na (< 0: geometry_failure's
-    code: −1 − i, contact i's normal undefined; −1 − n_contacts − i, contact i passed through).
+                 kept_pose, k, out):
+    """Free velocity, contact kinematics and the active set of step k; returns na (< 0: geometry_failure's
+    code: −1 − i, contact i's normal undefined; −1 − n_contacts − i, contact i passed through;
+    records_full: no column of the records `out` left for a new candidate, _open_column).
     room: floats the broad phase may use (the step's scratch, free until the solve; empty: none);
     kept, kept_pose: its kept list (Scratch's; empty: none, every contact tested)."""
     h, gamma = params[P_H], params[P_GAMMA]
@@ -581,6 +628,8 @@ def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_k
                     ht[i, d] = 0.0
                 gaps[i], drifts[i] = math.inf, 0.0
             continue
+        if out.column[i] == 0 and not _open_column(i, k, table, out):
+            return records_full(table.shape[0])  # (the step is run again once the records are wider)
         gap, drift = contact_kinematics(table, index, i, qk, vk, hn[i], ht[i])
         if math.isnan(gap):
             return -1 - i
@@ -838,7 +887,7 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
     returns a run status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
     q, v, p_normal, p_tangent, slip, state_rec = out.q, out.v, out.p_normal, out.p_tangent, out.slip, out.states
     impact_t, impact_step, impact_contact = out.impact_t, out.impact_step, out.impact_contact
-    counters, joint_impulse = out.counters, out.joint_impulse
+    counters, joint_impulse, column = out.counters, out.joint_impulse, out.column  # (column: _open_column)
     h, theta = params[P_H], params[P_THETA]
     t = step_time(params, k)
     v_next = v[k + 1]
@@ -856,26 +905,29 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
     status = RUN_OK
     broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # as begin_arrays' broad phase
     for i in range(table.shape[0]):
-        p_normal[k, i] = 0.0
-        p_tangent[k, i] = 0.0
-        state_rec[k, i] = 0
         grazing[i] = 0
+        c = column[i] - 1  # contact i's records' column (−1: none, never a candidate)
+        if c < 0:
+            continue  # no records to write: those of a contact out of reach (_open_column)
+        p_normal[k, c] = 0.0
+        p_tangent[k, c] = 0.0
+        state_rec[k, c] = 0
         if not broad or candidate[i]:
-            slip[k, i] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
+            slip[k, c] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
         else:  # a contact out of reach has zero rows: only the belt's surface velocity is left
-            slip[k, i] = -table[i, C_SURFACE_VELOCITY]
+            slip[k, c] = -table[i, C_SURFACE_VELOCITY]
     for a in range(na):
         i = active[a]
-        p_normal[k, i], p_tangent[k, i], state_rec[k, i] = p[2 * a], p[2 * a + 1], states[a]
+        c = column[i] - 1  # (an active contact is a candidate: it has its column)
+        p_normal[k, c], p_tangent[k, c], state_rec[k, c] = p[2 * a], p[2 * a + 1], states[a]
         if states[a] == STATE_OPEN and was_closed[i] and _rides_the_gap(i, params, gaps, drifts, hn, ht, a_free,
                                                                         table, index, v_next):
             grazing[i] = 1  # no force this step (reported open), yet not apart: no impact on return
-        slip_sign[i] = 1.0 if state_rec[k, i] == STATE_SLIP_PLUS else (-1.0 if state_rec[k, i] == STATE_SLIP_MINUS
-                                                                        else 0.0)
+        slip_sign[i] = 1.0 if states[a] == STATE_SLIP_PLUS else (-1.0 if states[a] == STATE_SLIP_MINUS else 0.0)
     for i in range(table.shape[0]):
         if broad and not candidate[i]:
             continue  # no impulse, not grazing, and not closed before (a closed contact is a candidate)
-        closed = p_normal[k, i] > 0.0
+        closed = p_normal[k, column[i] - 1] > 0.0
         if closed and not was_closed[i]:
             # An impact: a contact that was apart closes with approaching velocity. A persistent
             # contact that rode its gap without impulse for a step stays closed (grazing), so it
@@ -955,14 +1007,15 @@ def _rides_the_gap(i, params, gaps, drifts, hn, ht, a_free, table, index, v_next
 
 
 @_inlined
-def _warm_start(k, na, active, was_closed, p_normal, p_tangent, p):
-    """The previous step's impulses of the contacts that stay closed (pgs starts from p)."""
+def _warm_start(k, na, active, was_closed, p_normal, p_tangent, column, p):
+    """The previous step's impulses of the contacts that stay closed (pgs starts from p; column:
+    Records.column, a closed contact's records in column[i] − 1)."""
     if k == 0:
         return
     for a in range(na):
         i = active[a]
         if was_closed[i]:
-            p[2 * a], p[2 * a + 1] = p_normal[k - 1, i], p_tangent[k - 1, i]
+            p[2 * a], p[2 * a + 1] = p_normal[k - 1, column[i] - 1], p_tangent[k - 1, column[i] - 1]
 
 
 @jit
@@ -1001,9 +1054,10 @@ def _dense_fits(solver_code, na, joints, scratch_w):
 
 @_inlined
 def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index, joints, joint_buffer, gaps, hn, ht,
-                 active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, counters, scratch, p, u, states):
+                 active, was_closed, grazing, slip_sign, v_free, p_normal, p_tangent, column, counters, scratch, p, u,
+                 states):
     """assemble + the two-coefficient kernel into p, u, states (step_impulses' views), in the
-    per-run scratch (Scratch); p_normal, p_tangent: the records (the warm start).
+    per-run scratch (Scratch); p_normal, p_tangent, column: the records (the warm start).
     Returns the kernel status. Borrowing: it allocates nothing (the dense W fits: step_arrays)."""
     s_floats, s_w = scratch.floats, scratch.W
     s_sparse_ints, s_sparse_floats = scratch.sparse_ints, scratch.sparse_floats
@@ -1024,7 +1078,7 @@ def solve_arrays(solver_code, k, params, iparams, na, qk, vk, minv, table, index
         p[r], u[r] = 0.0, 0.0
     for a in range(na):
         states[a] = 0
-    _warm_start(k, na, active, was_closed, p_normal, p_tangent, p)
+    _warm_start(k, na, active, was_closed, p_normal, p_tangent, column, p)
     if sparse:
         nnz = delassus_blocks(na, minv, index, hn, ht, active, s_sparse_ints, s_sparse_floats)
         indptr, indices, blocks = sparse_views(na, minv.shape[0] // 3, nnz, s_sparse_ints, s_sparse_floats)
@@ -1061,7 +1115,7 @@ def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
         drive_arrays(k, params, m.contacts, m.motions, m.motion_times, m.motion_values, m.motion_now)
     na = begin_arrays(params, qk, vk, f, m.minv, m.contacts, m.contact_index, m.disks, m.disk_body, m.pair_keys,
                       m.pair_contact, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht, w.active, w.was_closed,
-                      w.v_free, w.a_free, w.candidate, scratch.floats, scratch.kept, scratch.kept_pose)
+                      w.v_free, w.a_free, w.candidate, scratch.floats, scratch.kept, scratch.kept_pose, k, o)
     if na < 0:
         return geometry_failure(na, m.contacts.shape[0], o.counters)
     if m.driven.shape[0] > 0:
@@ -1074,7 +1128,7 @@ def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
         status = solve_arrays(
             solver_code, k, params, iparams, na, qk, vk, m.minv, m.contacts, m.contact_index, m.joints,
             w.joint_buffer, w.gaps, w.hn, w.ht, w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free,
-            o.p_normal, o.p_tangent, o.counters, scratch, p, u, states)
+            o.p_normal, o.p_tangent, o.column, o.counters, scratch, p, u, states)
         if status != KERNEL_SOLVED:
             o.counters[K_SOLVER_STATUS] = status
             return RUN_SOLVER_FAILED
@@ -1179,7 +1233,7 @@ def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
         status = run_arrays(solver_code, k_start, k, k_end, params, iparams, extra, scratch, f, ring, before, model,
                             work, out)
         if status != RUN_SCRATCH_SHORT:
-            return status
+            return status  # (RUN_RECORDS_SHORT: the records are widened in Python, moreau_jean._advance)
         # a step with more active contacts than the dense W holds (lemke, enum, joints): room for
         # twice as many, and the step again from its start (its begin recomputes what it wrote)
         k = scratch.need[0]
@@ -1206,8 +1260,8 @@ def run_arrays(solver_code, k_start, k_first, k_end, params, iparams, extra, scr
         for d in range(extra.shape[0]):
             f[d] += extra[d]
         status = step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch)
-        if status == RUN_SCRATCH_SHORT:
-            return status
+        if status == RUN_SCRATCH_SHORT or status == RUN_RECORDS_SHORT:
+            return status  # (step k not done: counters[K_DONE] = k)
         if end_of_step(k, status, o.counters) != RUN_OK:
             return o.counters[K_STATUS]
         if repeats:
@@ -1247,10 +1301,11 @@ def _fixed_period(k, steps_here, q, v, p_normal, p_tangent, memory):
             if q[k + 1, d] != q[k + 1 - period, d] or v[k + 1, d] != v[k + 1 - period, d]:
                 same = False
                 break
-        for i in range(p_normal.shape[1] if same else 0):
-            if p_normal[k, i] != p_normal[k - period, i] or p_tangent[k, i] != p_tangent[k - period, i]:
+        for c in range(p_normal.shape[1] if same else 0):  # the records' columns (new_records)
+            if p_normal[k, c] != p_normal[k - period, c] or p_tangent[k, c] != p_tangent[k - period, c]:
                 same = False
                 break
+        for i in range(memory.shape[2] if same else 0):  # every contact's memory
             for m in range(3):
                 if memory[k % 3, m, i] != memory[(k - period) % 3, m, i]:
                     same = False

@@ -11,10 +11,13 @@ arrays, `chunk` steps long after `HISTORY` rows of the steps before). Between wi
 * the impacts, with the rows around them.
 
 So memory follows what is kept, not the number of steps, and a stop condition can be tried
-between windows. `ResumeState` is what the next step reads from the steps before it — q, v,
-the contact memory (closed, grazing, slip signs) and the last HISTORY rows of records (warm
-starts, phase location) — with the step grid (origin, index): a restart continues the very
-same floats.
+between windows. The window's per-contact records have a column only for the contacts that have
+been candidates (moreau_jean_loop.new_records: found contacts list hundreds that never come
+near); what is taken from them is every contact's (`Window.full`), those without a column
+holding the records of a contact out of reach. `ResumeState` is what the next step reads from
+the steps before it — q, v, the contact memory (closed, grazing, slip signs) and the last
+HISTORY rows of records (warm starts, phase location) — with the step grid (origin, index): a
+restart continues the very same floats.
 """
 from __future__ import annotations
 
@@ -29,7 +32,8 @@ from .sampling import save_slots
 # Rows of records a window keeps from the steps before its first: the warm start reads one, the
 # location of a phase boundary at step k reads steps k − 4 … k − 1 (moreau_jean._boundary_offset).
 HISTORY = 4
-# The largest window (steps): its rows cost 16 n_dof + 32 n_contacts bytes a step.
+# The largest window (steps): its rows cost 16 n_dof + 32 bytes a step per record column (at most
+# n_contacts: moreau_jean_loop.new_records).
 MAX_CHUNK = 1 << 16
 # Work arrays of moreau_jean_loop that carry a contact's memory from one step to the next.
 WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
@@ -126,12 +130,17 @@ class Window:
 
     Row r holds the state at step k_base + r and the records of the step leaving it."""
 
-    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0, out=None):
-        """`out`: zeroed records of this shape lent by an earlier run (integrators/scene_plans.py)."""
+    def __init__(self, n_dof: int, n_contacts: int, chunk: int, joint_rows: int = 0, out=None, columns=None,
+                 slip_default=None):
+        """`out`: zeroed records of this shape lent by an earlier run (integrators/scene_plans.py);
+        `columns`: the record columns to start with (None: one a contact, new_records), widened
+        when the candidates need more; `slip_default`: the slip record of a contact out of reach
+        (−its belt's surface velocity, as the loop writes it; default −0.0)."""
         rows = HISTORY + chunk
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
-        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows) if out is None else out
+        self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows, columns) if out is None else out
         self.rows, self.k_base, self.r = rows, 0, 0
+        self.slip_default = np.full(n_contacts, -0.0) if slip_default is None else slip_default
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
         q, v = self.out[0], self.out[1]
@@ -140,10 +149,72 @@ class Window:
         else:
             m = resume.states.shape[0]
             q[: m + 1], v[: m + 1] = resume.q, resume.v
-            for j, name in enumerate(RECORDS):
-                self.out[2 + j][:m] = getattr(resume, name)
+            self._seed_records([getattr(resume, name) for name in RECORDS], m)
             self.r = m
         self.k_base = first - self.r
+
+    def _seed_records(self, rows: list, m: int) -> None:
+        """The resumed history's records (every contact's, RECORDS order) into rows 0 … m − 1: a
+        column for each contact whose records are not those of a contact out of reach (bit for
+        bit: a slip of 0.0 is not −0.0); the others get theirs when they are candidates."""
+        column = self.out[loop.O_COLUMN]
+        n = column.shape[0] - 1
+        p_normal, p_tangent, slip, states = rows
+        own = ((p_normal != 0.0).any(axis=0) | (p_tangent != 0.0).any(axis=0) | (states != 0).any(axis=0)
+               | (slip.view(np.int64) != self.slip_default.view(np.int64)).any(axis=0))
+        new = np.flatnonzero(own & (column[:n] == 0))
+        while column[n] + new.size > self.out[2].shape[1]:
+            self.widen()
+            column = self.out[loop.O_COLUMN]
+        column[new] = column[n] + 1 + np.arange(new.size)
+        column[n] += new.size
+        contacts, cols, _ = self.columns()
+        for j, a in enumerate(rows):
+            self.out[2 + j][:m, cols] = a[:, contacts]
+
+    def widen(self) -> None:
+        """Twice the record columns (at most one a contact), every row so far kept: a new candidate
+        found them all taken (moreau_jean_loop.RUN_RECORDS_SHORT)."""
+        old = self.out
+        n_contacts, width = old[loop.O_COLUMN].shape[0] - 1, old[2].shape[1]
+        new = loop.new_records(old[0].shape[1], n_contacts, self.rows, old[6].shape[0],
+                               old[loop.O_JOINT_IMPULSE].shape[1], min(n_contacts, max(1, 2 * width)))
+        for a, b in zip(old, new):
+            if a.shape == b.shape:
+                b[...] = a
+            else:  # a per-contact record
+                b[:, :width] = a
+        self.out = new
+
+    def columns(self):
+        """(contacts, columns, whether every contact's column is its index): the contacts that have
+        a column of the records, in order, and their columns."""
+        column = self.out[loop.O_COLUMN]
+        n = column.shape[0] - 1
+        contacts = np.flatnonzero(column[:n])
+        cols = column[contacts] - 1
+        return contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
+
+    def owners(self) -> np.ndarray:
+        """The contact of each column given, in column order (the order they were given in)."""
+        contacts, cols, _ = self.columns()
+        owner = np.empty(contacts.size, dtype=np.int64)
+        owner[cols] = contacts
+        return owner
+
+    def full(self, which: int, rows):
+        """Record `which` (2 … 5: p_normal, p_tangent, slip, states) at `rows` (an index, a slice,
+        an array) for every contact: those without a column hold a contact out of reach's records
+        (0, or slip_default). A view when every contact has its own column in order."""
+        a = self.out[which]
+        contacts, cols, identity = self.columns()
+        if identity:
+            return a[rows]
+        part = a[rows][..., cols]
+        every = np.empty(part.shape[:-1] + (self.slip_default.shape[0],), dtype=a.dtype)
+        every[...] = self.slip_default if which == 4 else 0
+        every[..., contacts] = part
+        return every
 
     def room(self) -> int:
         return self.rows - self.r
@@ -162,10 +233,17 @@ class Window:
     def resume_state(self, grid: Grid, work, last_h: float, on_grid: bool) -> ResumeState:
         r, out = self.r, self.out
         lo = r - min(HISTORY, r)
+        records = (np.array(self.full(j, slice(lo, r))) for j in range(2, 6))
         return ResumeState(grid.origin if on_grid else grid.t_end, self.k_base + r if on_grid else 0, grid.h,
-                           on_grid, last_h, out[0][lo: r + 1].copy(), out[1][lo: r + 1].copy(), out[2][lo: r].copy(),
-                           out[3][lo: r].copy(), out[4][lo: r].copy(), out[5][lo: r].copy(),
+                           on_grid, last_h, out[0][lo: r + 1].copy(), out[1][lo: r + 1].copy(), *records,
                            work[WORK_CLOSED].copy(), work[WORK_GRAZING].copy(), work[WORK_SLIP_SIGN].copy())
+
+
+def _spread(part: np.ndarray, positions: np.ndarray, width: int) -> np.ndarray:
+    """Rows of records of some contacts (`part`) placed at `positions` of rows `width` wide, zeros elsewhere."""
+    spread = np.zeros((part.shape[0], width), dtype=part.dtype)
+    spread[:, positions] = part
+    return spread
 
 
 def kept_steps(grid: Grid, lo: int, hi: int, save_every: float | None) -> np.ndarray:
@@ -240,10 +318,10 @@ class Collector:
         before = np.maximum(rows - 1, 0)
         has_step = (rows >= 1)[:, None]
         self.a[m] = np.where(has_step, (out[1][rows] - out[1][before]) / h, np.nan)
-        self.N[m] = np.where(has_step, out[2][before] / h, 0.0)
-        self.T[m] = np.where(has_step, out[3][before] / h, 0.0)
+        self.N[m] = np.where(has_step, window.full(2, before) / h, 0.0)
+        self.T[m] = np.where(has_step, window.full(3, before) / h, 0.0)
         self.joint_force[m] = np.where(has_step, out[loop.O_JOINT_IMPULSE][before] / h, 0.0)
-        self.codes[m] = out[5][before]  # the first sample of a fresh run: the mode of its first step
+        self.codes[m] = window.full(5, before)  # the first sample of a fresh run: the mode of its first step
         self.n += ks.size
 
     def _contiguous_samples(self, window: Window, r0: int, ks: np.ndarray) -> None:
@@ -253,56 +331,68 @@ class Collector:
         if r0 == 0:  # the run's first state: no step leads to it
             first = self.n
             self.t[first], self.q[first], self.v[first] = self.grid.time(ks[:1])[0], out[0][0], out[1][0]
-            self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, out[5][0]
+            self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, window.full(5, 0)
             self.joint_force[first] = 0.0
             self.n, ks, r0, n = first + 1, ks[1:], 1, n - 1
         rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(self.n, self.n + n)
         h = self.grid.h if not (self.grid.h_last or self.resume is not None) else self.step_size(ks)[:, None]
         self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
         np.divide(out[1][rows] - out[1][before], h, out=self.a[m])
-        np.divide(out[2][before], h, out=self.N[m])
-        np.divide(out[3][before], h, out=self.T[m])
+        np.divide(window.full(2, before), h, out=self.N[m])
+        np.divide(window.full(3, before), h, out=self.T[m])
         np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
-        self.codes[m] = out[5][before]
+        self.codes[m] = window.full(5, before)
         self.n += n
 
     def _runs_and_rows(self, window: Window, k_from: int, k_to: int) -> None:
         out = window.out
-        r_lo = 0 if self._codes_before is None else k_from - window.k_base  # a resumed run: from its history
+        first = self._codes_before is None
+        r_lo = 0 if first else k_from - window.k_base  # a resumed run: from its history
         codes = out[5][r_lo: k_to - window.k_base]
         if not codes.shape[0]:
             return
+        owner = window.owners()  # the contact of each column given
+        codes = codes[:, :owner.size]  # (a view: the columns given)
+        n, k0 = len(self.runs), window.k_base + r_lo
+        before = np.zeros(n, dtype=codes.dtype) if first else self._codes_before  # every contact's
         changed = np.empty(codes.shape, dtype=bool)
         np.not_equal(codes[1:], codes[:-1], out=changed[1:])
-        changed[0] = True if self._codes_before is None else codes[0] != self._codes_before
+        np.not_equal(codes[0], before[owner], out=changed[0])
+        if first:  # every contact's first run starts here (one without a column: open)
+            start = before.copy()
+            start[owner] = codes[0]
+            for i in range(n):
+                self.runs[i].append((k0, int(start[i])))
+            changed[0] = False
         rows_changed = np.flatnonzero(changed.any(axis=1))
         for m in rows_changed:  # few: a contact's state changes at its phase boundaries
-            for i in np.flatnonzero(changed[m]):
-                self.runs[i].append((window.k_base + r_lo + int(m), int(codes[m, i])))
+            for c in np.flatnonzero(changed[m]):
+                self.runs[owner[c]].append((k0 + int(m), int(codes[m, c])))
+        if first and n:
+            rows_changed = np.r_[0, rows_changed]
         if rows_changed.size:
-            self._keep_rows(window, window.k_base + r_lo + rows_changed, k_to)
-        self._codes_before = codes[-1].copy()
+            self._keep_rows(window, k0 + rows_changed, k_to, owner)
+        self._codes_before = before.copy()
+        self._codes_before[owner] = codes[-1]
 
-    def _keep_rows(self, window: Window, steps: np.ndarray, k_to: int) -> None:
+    def _keep_rows(self, window: Window, steps: np.ndarray, k_to: int, owner) -> None:
         """The rows of steps k − HISTORY … k for each state change at step k, as arrays (a
-        contact that chatters changes every step: its rows cost what the per-step records did)."""
+        contact that chatters changes every step: its rows cost what the per-step records did);
+        the records of the columns given (`owner`: their contacts)."""
         out = window.out
         need = np.unique((steps[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
         need = need[(need >= window.k_base) & (need <= k_to)]
         r = need - window.k_base
-        rec = np.minimum(r, out[2].shape[0] - 1)
-        self._blocks.append((need, out[0][r], out[1][r], out[2][rec], out[3][rec], out[5][rec], need < k_to))
+        rec, given = np.minimum(r, out[2].shape[0] - 1), owner.size
+        self._blocks.append((need, out[0][r], out[1][r], out[2][rec, :given], out[3][rec, :given],
+                             out[5][rec, :given], need < k_to, owner))
         self._index = None
 
     def _row(self, j):
-        """(q, v, p_normal, p_tangent, states) of global step j (records None if not kept), or None."""
+        """(q, v, p_normal, p_tangent, states) of global step j (records None if not kept; of the
+        contacts with a column, at `_position`), or None."""
         if self._index is None:
-            blocks = list(zip(*self._blocks)) if self._blocks else [np.zeros(0, dtype=np.int64)] + [np.zeros(0)] * 6
-            steps, *arrays = (np.concatenate(b) for b in blocks)
-            # a step kept twice (the last of one window, again in the next): its later copy has its records
-            order = np.lexsort((arrays[-1], steps))
-            last = np.r_[steps[order][1:] != steps[order][:-1], True]
-            self._index = (steps[order][last], *(a[order][last] for a in arrays))
+            self._index_blocks()
         steps = self._index[0]
         m = int(np.searchsorted(steps, j))
         if m == steps.size or steps[m] != j:
@@ -310,13 +400,28 @@ class Collector:
         q, v, pn, pt, st, valid = (a[m] for a in self._index[1:])
         return (q, v, pn, pt, st) if valid else (q, v, None, None, None)
 
+    def _index_blocks(self) -> None:
+        """The kept rows by step, each block's records spread over the columns the last has (a
+        column is never taken back: the last block's columns hold every earlier one's)."""
+        every = self._blocks[-1][-1] if self._blocks else np.zeros(0, dtype=np.int64)
+        self._position = np.full(len(self.runs), -1)
+        self._position[every] = np.arange(every.size)
+        blocks = [b[:3] + tuple(_spread(a, self._position[b[-1]], every.size) for a in b[3:6]) + (b[6],)
+                  for b in self._blocks]
+        columns = list(zip(*blocks)) if blocks else [np.zeros(0, dtype=np.int64)] + [np.zeros(0)] * 6
+        steps, *arrays = (np.concatenate(b) for b in columns)
+        # a step kept twice (the last of one window, again in the next): its later copy has its records
+        order = np.lexsort((arrays[-1], steps))
+        last = np.r_[steps[order][1:] != steps[order][:-1], True]
+        self._index = (steps[order][last], *(a[order][last] for a in arrays))
+
     def _impacts(self, window: Window) -> None:
         out = window.out
         counters = out[9]
         for n in range(int(counters[loop.K_N_IMPACTS])):
             r, i = int(out[7][n]), int(out[8][n])
             self.impact_rows.append((window.k_base + r, i, float(out[6][n]), out[0][r].copy(), out[1][r].copy(),
-                                     out[1][r + 1].copy(), out[2][r].copy(), out[3][r].copy()))
+                                     out[1][r + 1].copy(), np.array(window.full(2, r)), np.array(window.full(3, r))))
         counters[loop.K_N_IMPACTS] = 0
 
     def trajectory_arrays(self):
@@ -325,18 +430,23 @@ class Collector:
             return self.t, self.q, self.v, self.a, self.N, self.T, self.codes
         return self.t[:n], self.q[:n], self.v[:n], self.a[:n], self.N[:n], self.T[:n], self.codes[:n]
 
-    # What located_phases reads, by global step (NaN / −1 where the run has no such row).
-    def p_normal(self, j, i):
+    # What located_phases reads, by global step (NaN / −1 where the run has no such row; a contact
+    # without a column of the records: those of a contact out of reach).
+    def _record(self, j, i, which, missing):
         row = self._row(j)
-        return math.nan if row is None or row[2] is None else float(row[2][i])
+        if row is None or row[which] is None:
+            return missing
+        at = self._position[i]
+        return row[which][at] if at >= 0 else 0
+
+    def p_normal(self, j, i):
+        return float(self._record(j, i, 2, math.nan))
 
     def p_tangent(self, j, i):
-        row = self._row(j)
-        return math.nan if row is None or row[3] is None else float(row[3][i])
+        return float(self._record(j, i, 3, math.nan))
 
     def state(self, j, i):
-        row = self._row(j)
-        return -1 if row is None or row[4] is None else int(row[4][i])
+        return int(self._record(j, i, 4, -1))
 
     def qv(self, j):
         row = self._row(j)
