@@ -54,7 +54,7 @@ from .kernel_base import (
 )
 from .problem import NoConvergence, PlanarFrictionProblem
 from .delassus import count_blocks, coupled_components, fill_blocks, group_matrix
-from .sticking import gather_contacts
+from .sticking import RANK_TOL, _frobenius, _upper_inverse, gather_contacts
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
 # corner contact of a body with rotational inertia never gets there, but e.g. a contact on
@@ -236,6 +236,23 @@ def pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, f
 
 
 @jit
+def _mode_solution(A, b):
+    """lstsq's minimum-norm least-squares solution of A x = b. A square A (every mode of a row of
+    balls) whose QR certifies it well conditioned — ‖R‖_F ‖R⁻¹‖_F < 1/RANK_TOL bounds σ_max/σ_min,
+    the hold search's certificate — is solved through that QR (Aᵀ = QR, x = Q R⁻ᵀ b): the same
+    unique solution to round-off, a fraction of lstsq's SVD (issue 26: the polish was ~15 µs of a
+    row of 16's step). Either way the polish keeps it only if the whole problem then meets the
+    residual target."""
+    n = A.shape[0]
+    if n > 0 and n == A.shape[1]:
+        Q, R = np.linalg.qr(np.ascontiguousarray(A.T))
+        R_inv = _upper_inverse(R)
+        if _frobenius(R) * _frobenius(R_inv) < 1.0 / RANK_TOL:
+            return np.ascontiguousarray(Q) @ (np.ascontiguousarray(R_inv.T) @ b)
+    return np.linalg.lstsq(A, b)[0]
+
+
+@jit
 def solve_mode(W, q, lo, hi, p, u):
     """Replace p, u (one group, dense W) by the exact solution of the mode p shows: a contact with
     p_N > 0 touches (u_N = 0) and sticks (u_T = 0) if p_T is strictly inside its interval, else
@@ -269,7 +286,7 @@ def solve_mode(W, q, lo, hi, p, u):
     for j in range(r):
         A[j, :] = WP[rows[j], :]
         b[j] = -q[rows[j]]
-    x = np.linalg.lstsq(A, b)[0]
+    x = _mode_solution(A, b)
     p_new = P @ x
     if not all_finite(p_new):
         return False
