@@ -243,13 +243,22 @@ def _mode_solution(A, b):
     unique solution to round-off, a fraction of lstsq's SVD (issue 26: the polish was ~15 µs of a
     row of 16's step). Either way the polish keeps it only if the whole problem then meets the
     residual target."""
+    certain, x = _certified_square_solution(A, b)
+    return x if certain else np.linalg.lstsq(A, b)[0]
+
+
+@jit
+def _certified_square_solution(A, b):
+    """(True, A⁻¹ b) through the QR of Aᵀ when A is square and ‖R‖_F ‖R⁻¹‖_F < 1/RANK_TOL, else
+    (False, ·)."""
     n = A.shape[0]
-    if n > 0 and n == A.shape[1]:
-        Q, R = np.linalg.qr(np.ascontiguousarray(A.T))
-        R_inv = _upper_inverse(R)
-        if _frobenius(R) * _frobenius(R_inv) < 1.0 / RANK_TOL:
-            return np.ascontiguousarray(Q) @ (np.ascontiguousarray(R_inv.T) @ b)
-    return np.linalg.lstsq(A, b)[0]
+    if n == 0 or n != A.shape[1]:
+        return False, np.zeros(A.shape[1])
+    Q, R = np.linalg.qr(np.ascontiguousarray(A.T))
+    R_inv = _upper_inverse(R)
+    if not (_frobenius(R) * _frobenius(R_inv) < 1.0 / RANK_TOL):
+        return False, np.zeros(n)
+    return True, np.ascontiguousarray(Q) @ (np.ascontiguousarray(R_inv.T) @ b)
 
 
 @jit
