@@ -186,3 +186,38 @@ def test_the_mode_polish_finishes_a_pushed_chain_in_few_sweeps():
     assert complementarity_residual(problem, solution.p) <= 1e-12 * scale
     lemke = solve(problem, "lemke")  # the same velocities as Lemke's pivoting
     np.testing.assert_allclose(solution.u, lemke.u, rtol=0, atol=1e-10 * scale)
+
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_polish_solves_a_well_conditioned_square_mode_by_qr_as_lstsq_would(compiled):
+    """gauss_seidel._certified_square_solution (the polish's solve, before lstsq's SVD): it vouches
+    for a square mode only when every singular value is above RANK_TOL × the largest, and then
+    gives lstsq's solution — the unique one — to round-off; a singular square or a rectangular A is
+    declined (lstsq solves it, minimum norm, as before). Issue 26: the polish's SVD was ~15 µs of
+    a row of 16's step."""
+    from nonsmooth_rod.solvers import gauss_seidel
+    from nonsmooth_rod.solvers.sticking import RANK_TOL
+    solve_mode = gauss_seidel._certified_square_solution
+    solve_mode = solve_mode if compiled else getattr(solve_mode, "py_func", solve_mode)
+    rng = np.random.default_rng(8)
+    certified = declined = 0
+    for trial in range(200):
+        n = int(rng.integers(1, 30))
+        A, b = rng.normal(size=(n, n)), rng.normal(size=n)
+        if trial % 4 == 0 and n > 1:  # a repeated row, up to a perturbation at or below RANK_TOL
+            A[-1] = A[0] * 4.0 + rng.normal(size=n) * 10.0 ** rng.uniform(-20, -10)
+        if trial % 7 == 0:
+            A = A[:, : max(1, n - 2)].copy()
+        ok, x = solve_mode(A, b)
+        s = np.linalg.svd(A, compute_uv=False)
+        if A.shape[0] != A.shape[1] or s[-1] <= RANK_TOL * s[0]:
+            assert not ok
+        if not ok:
+            declined += 1
+            continue
+        certified += 1
+        reference = np.linalg.lstsq(A, b, rcond=None)[0]
+        tolerance = 1e3 * np.finfo(float).eps * (s[0] / s[-1]) * np.max(np.abs(reference))
+        assert np.max(np.abs(x - reference)) <= tolerance
+    assert certified > 100 and declined > 40

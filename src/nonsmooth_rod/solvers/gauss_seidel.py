@@ -54,7 +54,7 @@ from .kernel_base import (
 )
 from .problem import NoConvergence, PlanarFrictionProblem
 from .delassus import count_blocks, coupled_components, fill_blocks, group_matrix
-from .sticking import gather_contacts
+from .sticking import RANK_TOL, _frobenius, _upper_inverse, gather_contacts
 
 # The local stick system counts as singular when det(W_ii) ≤ SINGULAR_DET · a·c. A disk or
 # corner contact of a body with rotational inertia never gets there, but e.g. a contact on
@@ -236,6 +236,32 @@ def pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, f
 
 
 @jit
+def _mode_solution(A, b):
+    """lstsq's minimum-norm least-squares solution of A x = b. A square A (every mode of a row of
+    balls) whose QR certifies it well conditioned — ‖R‖_F ‖R⁻¹‖_F < 1/RANK_TOL bounds σ_max/σ_min,
+    the hold search's certificate — is solved through that QR (Aᵀ = QR, x = Q R⁻ᵀ b): the same
+    unique solution to round-off, a fraction of lstsq's SVD (issue 26: the polish was ~15 µs of a
+    row of 16's step). Either way the polish keeps it only if the whole problem then meets the
+    residual target."""
+    certain, x = _certified_square_solution(A, b)
+    return x if certain else np.linalg.lstsq(A, b)[0]
+
+
+@jit
+def _certified_square_solution(A, b):
+    """(True, A⁻¹ b) through the QR of Aᵀ when A is square and ‖R‖_F ‖R⁻¹‖_F < 1/RANK_TOL, else
+    (False, ·)."""
+    n = A.shape[0]
+    if n == 0 or n != A.shape[1]:
+        return False, np.zeros(A.shape[1])
+    Q, R = np.linalg.qr(np.ascontiguousarray(A.T))
+    R_inv = _upper_inverse(R)
+    if not (_frobenius(R) * _frobenius(R_inv) < 1.0 / RANK_TOL):
+        return False, np.zeros(n)
+    return True, np.ascontiguousarray(Q) @ (np.ascontiguousarray(R_inv.T) @ b)
+
+
+@jit
 def solve_mode(W, q, lo, hi, p, u):
     """Replace p, u (one group, dense W) by the exact solution of the mode p shows: a contact with
     p_N > 0 touches (u_N = 0) and sticks (u_T = 0) if p_T is strictly inside its interval, else
@@ -269,7 +295,7 @@ def solve_mode(W, q, lo, hi, p, u):
     for j in range(r):
         A[j, :] = WP[rows[j], :]
         b[j] = -q[rows[j]]
-    x = np.linalg.lstsq(A, b)[0]
+    x = _mode_solution(A, b)
     p_new = P @ x
     if not all_finite(p_new):
         return False

@@ -235,19 +235,31 @@ def _full_row_rank_solution(A, b):
     x0 = Q₁ R₁₁⁻ᵀ b is the SVD's minimum-norm solution to round-off, and Z spans the same null
     space in another orthonormal basis. A QR and a triangular inverse cost a fraction of LAPACK's
     SVD, which was 45 % of a row of 16's CPU (one per LP of the hold search)."""
+    certain, Q1, R_inv_T, Z, sigma_min = _full_row_rank_parts(A)
+    if not certain:
+        return False, np.zeros(A.shape[1]), np.zeros((A.shape[1], 0))
+    return True, Q1 @ (R_inv_T @ b), Z
+
+
+@jit
+def _full_row_rank_parts(A):
+    """_full_row_rank_solution's factors: (certain, Q₁, R₁₁⁻ᵀ, Z, σ) with x0 = Q₁ (R₁₁⁻ᵀ b) for any b
+    and σ = 1/‖R₁₁⁻¹‖_F ≤ σ_min(A) (the pruning LPs bound a bordered A's smallest singular value
+    with it, `_pruning_split`)."""
     m, n = A.shape
     if m == 0 or m > n:
-        return False, np.zeros(n), np.zeros((n, 0))
+        return False, np.zeros((n, m)), np.zeros((m, m)), np.zeros((n, 0)), 0.0
     M = np.zeros((n, m + n))
     M[:, :m] = A.T
     for j in range(n):
         M[j, m + j] = 1.0
     Q, R = np.linalg.qr(M)
     R_inv = _upper_inverse(R[:m, :m])
-    if not (_frobenius(R[:m, :m]) * _frobenius(R_inv) < 1.0 / RANK_TOL):
-        return False, np.zeros(n), np.zeros((n, 0))
-    x0 = np.ascontiguousarray(Q[:, :m]) @ (np.ascontiguousarray(R_inv.T) @ b)
-    return True, x0, np.ascontiguousarray(Q[:, m:])
+    inverse_norm = _frobenius(R_inv)
+    if not (_frobenius(R[:m, :m]) * inverse_norm < 1.0 / RANK_TOL):
+        return False, np.zeros((n, m)), np.zeros((m, m)), np.zeros((n, 0)), 0.0
+    return (True, np.ascontiguousarray(Q[:, :m]), np.ascontiguousarray(R_inv.T), np.ascontiguousarray(Q[:, m:]),
+            1.0 / inverse_norm)
 
 
 @jit
@@ -398,9 +410,15 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
     A = np.ascontiguousarray((W @ P)[rows, :])
     b = -q[rows]
     x0, Z = _particular_and_null(A, b)
-    p0 = P @ x0
-    Pz = np.ascontiguousarray(P @ Z)
-    z = np.zeros(Z.shape[1])
+    return _deepest_admissible(W, q, mu_s, mode, sign, P @ x0, np.ascontiguousarray(P @ Z), velocity_tol, scale,
+                               p_out)
+
+
+@jit
+def _deepest_admissible(W, q, mu_s, mode, sign, p0, Pz, velocity_tol, scale, p_out):
+    """admissible_split once the mode's equations are solved: the split p0 + Pz z deepest inside
+    every cone (no simplex when Pz has no column), checked against the law."""
+    z = np.zeros(Pz.shape[1])
     G, h, weight = _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
     margin = _deepest_split(G, h, weight, z)
     if margin < -MARGIN_TOL:
@@ -601,13 +619,80 @@ def _prune(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, state
     other candidates free, and return how many: one the solver holds needs no test (its answer is
     a split of the relaxation); each other costs one LP."""
     kept = 0
+    relaxed = _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign)
     for c in range(n_c):
         _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
-        if states[candidates[c]] == STATE_STICK or _admissible_either(
-                W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+        added = np.array([2 * candidates[c] + 1]) if release[c] != 0.0 else \
+            np.array([2 * candidates[c], 2 * candidates[c] + 1])
+        if states[candidates[c]] == STATE_STICK or _pruning_either(
+                relaxed, added, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
             candidates[kept], release[kept] = candidates[c], release[c]
             kept += 1
     return kept
+
+
+@jit
+def _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign):
+    """What the pruning LPs of one search share (issue 26: each was a QR of the whole group). The
+    relaxation with every candidate free (MODE_FREE, MODE_LOOSE) has the unknowns of every pruning
+    LP — holding candidate c only adds its rows u_T = 0 (and u_N = 0 for one that lifts) — so its
+    equations A_f x = b_f are factored once: the solutions of a pruning LP's are x_f + Z_f w with
+    R_c Z_f w = b_c − R_c x_f, R_c the added rows (1 or 2). Returns (certain, P, rows, W P, Q₁,
+    R₁₁⁻ᵀ, Z_f, σ, ‖A_f‖²_F) — certain False when A_f's full row rank is not vouched for."""
+    _modes_for(0, candidates, release, n_c, u, states, mode, sign, True)
+    P, rows = _unknowns(mode, sign, mu_d)
+    WP = W @ P
+    A = np.ascontiguousarray(WP[rows, :])
+    certain, Q1, R_inv_T, Z, sigma_min = _full_row_rank_parts(A)
+    return certain, P, rows, WP, Q1, R_inv_T, Z, sigma_min, np.sum(A ** 2)
+
+
+@jit
+def _pruning_split(relaxed, added, W, q, mu_s, mode, sign, velocity_tol, scale, p_out):
+    """admissible_split of a pruning LP (mode and sign its own: one candidate held, the others
+    free) on the shared relaxation: 1 admissible, 0 not, −1 not vouched for (the caller takes
+    admissible_split). With M = R_c Z_f of full row rank (its own QR certificate), the LP's matrix
+    A_c = [A_f; R_c] has σ_min ≥ σ_M σ_f / (σ_f + ‖R_c‖_F + σ_M) (split a unit y into its parts on
+    A_f's rows and R_c's), so ‖A_c‖_F over that bound below 1/RANK_TOL means the SVD would find
+    A_c of full row rank too: both ways then have the same solutions x0 + Z z of the mode's
+    equations (Z = Z_f N orthonormal, N spanning M's null space) and the same deepest margin."""
+    certain, P, rows, WP, Q1, R_inv_T, Z_f, sigma_f, a_f2 = relaxed
+    if not certain:
+        return -1
+    b_f = np.empty(rows.shape[0])
+    for r in range(rows.shape[0]):
+        b_f[r] = -q[rows[r]]
+    x_f = Q1 @ (R_inv_T @ b_f)
+    R = np.ascontiguousarray(WP[added, :])
+    r_c = np.empty(added.shape[0])
+    for a in range(added.shape[0]):
+        r_c[a] = -q[added[a]] - np.dot(R[a, :], x_f)
+    certain_m, Q1_m, R_inv_T_m, N, sigma_m = _full_row_rank_parts(np.ascontiguousarray(R @ Z_f))
+    r_f = _frobenius(R)
+    if not certain_m or not (np.sqrt(a_f2 + r_f * r_f) * (sigma_f + r_f + sigma_m) < sigma_m * sigma_f / RANK_TOL):
+        return -1
+    x0 = x_f + Z_f @ (Q1_m @ (R_inv_T_m @ r_c))
+    Z = np.ascontiguousarray(Z_f @ N)
+    return 1 if _deepest_admissible(W, q, mu_s, mode, sign, P @ x0, np.ascontiguousarray(P @ Z), velocity_tol,
+                                    scale, p_out) else 0
+
+
+@jit
+def _pruning_either(relaxed, added, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+    """_admissible_either of a pruning LP, on the shared relaxation where it is vouched for
+    (_pruning_split), else the general way."""
+    found = _pruning_split(relaxed, added, W, q, mu_s, mode, sign, velocity_tol, scale, p_new)
+    if found < 0:
+        found = 1 if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new) else 0
+    if found == 1:
+        return True
+    if np.max(closing) <= 0.0:
+        return False
+    _without_gap_closing(q, closing, mode, q_held)
+    found = _pruning_split(relaxed, added, W, q_held, mu_s, mode, sign, velocity_tol, scale, p_new)
+    if found < 0:
+        return admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+    return found == 1
 
 
 @jit
@@ -633,6 +718,7 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
     allowed = (1 << n_c) - 1
     trials = 0
     p_found = np.empty_like(p_new)
+    shared = _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign)
     while True:
         found, n_found, common = -1, 0, allowed
         for size in range(_popcount(allowed), -1, -1):
@@ -645,7 +731,8 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
                     return -1
                 trials += 1
                 _modes_for(held, candidates, release, n_c, u, states, mode, sign, False)
-                if _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+                if _trial_either(shared, held, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale,
+                                 p_new):
                     found, n_found, common = held, n_found + 1, common & held
                     p_found[:] = p_new
             if n_found > 0:
@@ -657,6 +744,161 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
             p_new[:] = p_found
             return found
         allowed = common
+
+
+@jit
+def _small_inverse(S):
+    """Inverse of the small square S by Gauss–Jordan with partial pivoting; infinities when a pivot
+    is zero (they fail the certificate of _bordered_split)."""
+    s = S.shape[0]
+    M = np.zeros((s, 2 * s))
+    M[:, :s] = S
+    for i in range(s):
+        M[i, s + i] = 1.0
+    for col in range(s):
+        r = col
+        for i in range(col + 1, s):
+            if abs(M[i, col]) > abs(M[r, col]):
+                r = i
+        if not M[r, col] != 0.0:
+            return np.full((s, s), np.inf)
+        for k in range(2 * s):
+            M[col, k], M[r, k] = M[r, k], M[col, k]
+        M[col, :] /= M[col, col]
+        for i in range(s):
+            factor = M[i, col]
+            if i != col and factor != 0.0:
+                M[i, :] -= factor * M[col, :]
+    return np.ascontiguousarray(M[:, s:])
+
+
+@jit
+def _inverse_by_qr(A):
+    """A⁻¹ = R⁻¹ Qᵀ (LAPACK's QR, which never fails; infinities for a zero pivot of R)."""
+    if A.shape[0] == 0:
+        return np.zeros((0, 0))
+    Q, R = np.linalg.qr(A)
+    return _upper_inverse(R) @ np.ascontiguousarray(Q.T)
+
+
+@jit
+def _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign):
+    """What every held-set trial of one search shares, factored once (issue 26: the row of 16's
+    trials were each a fresh QR of the whole mode, 80 % of their cost). The base is the mode with
+    every candidate released; holding candidate c adds to it the unknown p_T of c (p_T = −μd s p_N
+    + δ) and the row u_T = 0 (one that lifts: p_N and p_T, u_N = 0 and u_T = 0): a trial's
+    equations are the base's bordered by its held candidates' entries `ext` (an unknown's entry of
+    p and a row's of u — the same indices). So with A0 the base's square matrix, B its columns in the
+    added directions, C the added rows and D their block, the trial solves through the Schur
+    complement S = D − C A0⁻¹ B restricted to its entries (at most 2 × 16). Returns the tuple
+    _bordered_split reads; its first entry False when the base is not square (a base with freedom
+    in its split: every trial goes the general way)."""
+    _modes_for(0, candidates, release, n_c, u, states, mode, sign, False)
+    P0, rows0 = _unknowns(mode, sign, mu_d)
+    n_ext = 0
+    for c in range(n_c):
+        n_ext += 2 if release[c] == 0.0 else 1
+    ext, owner = np.empty(n_ext, dtype=np.int64), np.empty(n_ext, dtype=np.int64)
+    e = 0
+    for c in range(n_c):
+        if release[c] == 0.0:
+            ext[e], owner[e] = 2 * candidates[c], c
+            e += 1
+        ext[e], owner[e] = 2 * candidates[c] + 1, c
+        e += 1
+    n0 = P0.shape[1]
+    WP0 = W @ P0
+    A0 = np.zeros((n0, n0))
+    B = np.zeros((n0, n_ext))
+    for r in range(min(n0, rows0.shape[0])):
+        A0[r, :] = WP0[rows0[r], :]
+        for e in range(n_ext):
+            B[r, e] = W[rows0[r], ext[e]]
+    C = np.zeros((n_ext, n0))
+    D = np.zeros((n_ext, n_ext))
+    for e in range(n_ext):
+        C[e, :] = WP0[ext[e], :]
+        for f in range(n_ext):
+            D[e, f] = W[ext[e], ext[f]]
+    A0_inv = _inverse_by_qr(A0)
+    Y, X = A0_inv @ B, C @ A0_inv
+    norms = np.zeros((4, n_ext))  # ‖B e‖², ‖C e‖², ‖Y e‖², ‖X e‖² of each added entry
+    for e in range(n_ext):
+        norms[0, e], norms[1, e] = np.sum(B[:, e] ** 2), np.sum(C[e, :] ** 2)
+        norms[2, e], norms[3, e] = np.sum(Y[:, e] ** 2), np.sum(X[e, :] ** 2)
+    ok = n0 > 0 and rows0.shape[0] == n0 and np.all(np.isfinite(A0_inv))
+    return (ok, P0, rows0, ext, owner, A0_inv, Y, C, D - C @ Y, D, norms,
+            np.array([np.sum(A0 ** 2), _frobenius(A0_inv), 1.5 * (1.0 + np.max(mu_d) ** 2)]))
+
+
+@jit
+def _bordered_solve(trials, chosen, S_inv, rhs, p_out):
+    """p_out += the solution of the trial's equations (rows of u = W p + q: base rows and `chosen`
+    added entries) for the right-hand side rhs (an entry per row of u): y = A0⁻¹ b0,
+    δ = S⁻¹ (b_e − C y), x = y − A0⁻¹B δ; p = P0 x + Σ δ_e at the added entries."""
+    ok, P0, rows0, ext, owner, A0_inv, Y, C, S_all, D, norms, scalars = trials
+    b0 = np.empty(rows0.shape[0])
+    for r in range(rows0.shape[0]):
+        b0[r] = rhs[rows0[r]]
+    y = A0_inv @ b0
+    s = chosen.shape[0]
+    r_e = np.empty(s)
+    for a in range(s):
+        r_e[a] = rhs[ext[chosen[a]]] - np.dot(C[chosen[a], :], y)
+    delta = S_inv @ r_e
+    for a in range(s):
+        y -= delta[a] * Y[:, chosen[a]]
+    p_out += P0 @ y
+    for a in range(s):
+        p_out[ext[chosen[a]]] += delta[a]
+
+
+@jit
+def _bordered_split(trials, held, W, q, mu_s, mode, sign, velocity_tol, scale, p_out):
+    """admissible_split of the trial holding the candidates in `held` (mode and sign already its
+    own) through the shared factorization: 1 admissible, 0 not, −1 not certified (the caller
+    takes admissible_split). Certified when ‖K‖_F ‖K⁻¹‖_F of the trial's bordered matrix K, the
+    inverse bounded block by block (K⁻¹ = [A0⁻¹ + Y S⁻¹ X, −Y S⁻¹; −S⁻¹ X, S⁻¹], Y = A0⁻¹B,
+    X = C A0⁻¹), times the change of basis from (p_N, p_T) to (p_N, δ) stays below 1/RANK_TOL: K
+    then has full rank at the SVD's threshold in admissible_split's unknowns too, so the mode fixes
+    the split and both ways find the same unique one, to round-off (one step of iterative
+    refinement on the residual of its equations)."""
+    ok, P0, rows0, ext, owner, A0_inv, Y, C, S_all, D, norms, scalars = trials
+    if not ok:
+        return -1
+    chosen = np.flatnonzero((held >> owner) & 1)
+    S_inv = _small_inverse(np.ascontiguousarray(S_all[chosen][:, chosen]))
+    k2, y2, x2 = scalars[0], 0.0, 0.0
+    for e in chosen:
+        k2 += norms[0, e] + norms[1, e] + np.sum(D[e, chosen] ** 2)
+        y2, x2 = y2 + norms[2, e], x2 + norms[3, e]
+    s_f = _frobenius(S_inv)
+    inv_bound = scalars[1] + s_f * (np.sqrt(y2 * x2) + np.sqrt(y2) + np.sqrt(x2) + 1.0)
+    if not (np.sqrt(k2) * inv_bound * scalars[2] < 1.0 / RANK_TOL):
+        return -1
+    p0 = np.zeros(q.shape[0])
+    _bordered_solve(trials, chosen, S_inv, -q, p0)
+    _bordered_solve(trials, chosen, S_inv, -(W @ p0 + q), p0)  # refinement: the residual's correction
+    return 1 if _deepest_admissible(W, q, mu_s, mode, sign, p0, np.zeros((q.shape[0], 0)), velocity_tol, scale,
+                                    p_out) else 0
+
+
+@jit
+def _trial_either(trials, held, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+    """_admissible_either of a held-set trial, through the shared factorization where it is
+    certified (_bordered_split), else the general way."""
+    found = _bordered_split(trials, held, W, q, mu_s, mode, sign, velocity_tol, scale, p_new)
+    if found < 0:
+        found = 1 if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new) else 0
+    if found == 1:
+        return True
+    if np.max(closing) <= 0.0:
+        return False
+    _without_gap_closing(q, closing, mode, q_held)
+    found = _bordered_split(trials, held, W, q_held, mu_s, mode, sign, velocity_tol, scale, p_new)
+    if found < 0:
+        return admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+    return found == 1
 
 
 @jit
