@@ -65,6 +65,8 @@ from .kernel_base import (
 def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
     """Lemke on the interval LCP, then on the cone LCP if that fails (as lemke_friction does),
     in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0] contacts).
+    p on entry is the warm start: the interval LCP first tries the basis it sits at
+    (lemke._warm_solution; zero pivots when that basis still solves the problem to rtol).
 
     Returns (status, pivots, residual); the first formulation's failure status when both fail.
     Compiled without reference counting (the step's hot path; it allocates nothing).
@@ -77,8 +79,9 @@ def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
     for attempt in range(2):
         formulation = INTERVAL if attempt == 0 else CONE
         limit = max_pivots if max_pivots > 0 else default_max_pivots((3 + attempt) * lo.shape[0])
+        warm_tol = rtol if attempt == 0 else 0.0  # (p, the warm start, is the first attempt's answer after it)
         residual, status, pivots, q_norm, W_norm, scale = _lemke_friction_into(W, q, lo, hi, limit, formulation,
-                                                                              floats, ints, p, u)
+                                                                              floats, ints, p, u, warm_tol)
         if status == SOLVED and residual <= rtol * (scale if scale > 0.0 else 1.0):
             return KERNEL_SOLVED, pivots, residual
         if attempt == 0:

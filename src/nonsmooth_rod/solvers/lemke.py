@@ -86,6 +86,13 @@ TIE_TOL = 1e-14
 # Accept a friction solution when complementarity_residual ≤ RESIDUAL_TOL · residual_scale.
 RESIDUAL_TOL = 1e-9
 
+# The warm start (_warm_solution): a tangential impulse within this fraction of the friction
+# interval's reach (max(|lo|, |hi|) p_N) of one of its ends counts as at that end; a basic value
+# (or a non-basic w) below −WARM_FEASIBILITY_TOL (normalised units, as PIVOT_TOL) makes the basis
+# infeasible for the new problem, and Lemke pivots from scratch.
+WARM_BOUND_TOL = 1e-9
+WARM_FEASIBILITY_TOL = 1e-12
+
 
 # The pivoting and its helpers are compiled without reference counting (_jit.jit_borrowing): they
 # take arrays and return numbers, so any caller may call them, and the row views they take in
@@ -379,12 +386,12 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     floats, ints = solver_scratch(len(lo))
     p, u = np.empty(2 * len(lo)), np.empty(2 * len(lo))
     residual, status, pivots, q_norm, W_norm, scale = _lemke_friction_into(W, q, lo, hi, max_pivots, formulation,
-                                                                          floats, ints, p, u)
+                                                                          floats, ints, p, u, 0.0)
     return p, u, residual, status, pivots, (q_norm, W_norm, scale)
 
 
 @jit_borrowing
-def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p, u):
+def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p, u, warm_tol):
     """Friction step → lifted LCP → Lemke → p, u (2 len(lo) each, written) and (residual,
     status, pivots, ‖q‖∞, max|W|, max(‖p‖∞, ‖u‖∞, ‖q‖∞)) — the norms for the acceptance test
     and the contact states (computed here, they cost nothing; in Python after the call,
@@ -398,6 +405,11 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     divided by max|D W D| and max|D q|, so that the pivoting tolerances act on O(1) numbers
     even when the contacts' W blocks differ by 1e12 (a heavy and a light body); p = D p̃ ·
     max|D q| / max|D W D| undoes it exactly.
+
+    ``warm_tol`` > 0 (the interval LCP only): p on entry is a warm start — the previous step's
+    impulses, or the sign iteration's previous solve — and the complementary basis it sits at
+    is tried first (_warm_solution: one small solve, no pivot); its answer is taken when it
+    passes the solver's own test, residual ≤ warm_tol · scale, else Lemke pivots from scratch.
     """
     n_c = len(lo)
     per_contact = 3 if formulation == INTERVAL else 4
@@ -407,6 +419,7 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     qs, at = carve(floats, at, 2 * n_c)
     M, at = carve_matrix(floats, at, n, n)
     qq, at = carve(floats, at, n)
+    tableau_at = at
     T, at = carve_matrix(floats, at, n, 2 * n + 2)
     z, at = carve(floats, at, n)
     refine, at = carve(floats, at, n)
@@ -420,22 +433,15 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
         _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
         _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
-    status, pivots, entering = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)
-
-    for i in range(2 * n_c):
-        p[i], u[i] = 0.0, 0.0
-    residual = 0.0
-    if status == SOLVED or status == RAY:
-        for j in range(n_c):
-            to_impulse = d[j] * q_scale / w_scale
-            k = per_contact * j
-            p[2 * j] = z[k] * to_impulse
-            if formulation == INTERVAL:
-                p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
-            else:
-                p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
-        residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
-    scale = max(q_norm, _max_abs(p), _max_abs(u))
+    status, pivots = SOLVED, 0
+    warm = warm_tol > 0.0 and formulation == INTERVAL and _warm_solution(
+        M, qq, p, lo, hi, floats[tableau_at:tableau_at + n * n + n], ints[n:2 * n], z)
+    if warm:  # (the tableau's room holds the warm solve's n × n system: the cold path refills it)
+        residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
+        warm = residual <= warm_tol * scale
+    if not warm:
+        status, pivots, _ = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)  # (z = 0 unless solved)
+        residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
     if status == RAY:
         # Wedged contacts (two normals nearly opposed, W singular) make the solution set
         # unbounded, and Lemke may leave on a ray with z0 ~ 1e-11 instead of 0: the point it
@@ -443,6 +449,112 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
         if residual <= RESIDUAL_TOL * (scale if scale > 0.0 else 1.0):
             status = SOLVED
     return residual, status, pivots, q_norm, W_norm, scale
+
+
+@jit_borrowing
+def _impulses_of(z, d, to_units, formulation, W, q, lo, hi, q_norm, p, u):
+    """p from the LCP's z (per contact d_c · to_units undoes the scaling), u = W p + q:
+    (residual, max(‖q‖∞, ‖p‖∞, ‖u‖∞)). z = 0 gives p = 0, u = q."""
+    per_contact = 3 if formulation == INTERVAL else 4
+    for j in range(len(lo)):
+        to_impulse = d[j] * to_units
+        k = per_contact * j
+        p[2 * j] = z[k] * to_impulse
+        if formulation == INTERVAL:
+            p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
+        else:
+            p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
+    residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
+    return residual, max(q_norm, _max_abs(p), _max_abs(u))
+
+
+@jit_borrowing
+def _warm_basis(p, lo, hi, basic):
+    """The complementary basis of the interval LCP that the impulses p sit at: basic[k] = 1
+    when z_k is basic (else its w_k is). Per contact (p_N, β, σ): p_N basic when p_N > 0; β
+    basic unless p_T is at the interval's low end (β = 0); σ basic when p_T is at its high end
+    (slip −, or a stick there). A non-finite or non-positive p_N: the contact open, all w basic."""
+    for j in range(len(lo)):
+        k = 3 * j
+        p_n, p_t = p[2 * j], p[2 * j + 1]
+        basic[k], basic[k + 1], basic[k + 2] = 0, 0, 0
+        if not (p_n > 0.0 and np.isfinite(p_n) and np.isfinite(p_t)):
+            continue
+        basic[k] = 1
+        tol = WARM_BOUND_TOL * max(abs(lo[j]), abs(hi[j])) * p_n
+        beta, width = p_t - lo[j] * p_n, (hi[j] - lo[j]) * p_n
+        if beta > tol:
+            basic[k + 1] = 1
+            if beta >= width - tol:
+                basic[k + 2] = 1
+
+
+@jit_borrowing
+def _warm_solution(M, qq, p, lo, hi, room, support, z):
+    """z of the basis the warm start p sits at (_warm_basis) when that basis is feasible for
+    (M, qq): M_SS z_S = −qq_S on its basic set S (Gaussian elimination, partial pivoting), z_S ≥ 0
+    and w = M z + qq ≥ 0 off S, to WARM_FEASIBILITY_TOL. False — Lemke then pivots from scratch —
+    when M_SS is singular (PIVOT_TOL, as Lemke's pivots) or the basis is infeasible. The answer
+    is then complementary by construction: one of w_k, z_k is zero for each k.
+    room: n² + n floats of scratch; support: n ints."""
+    n = qq.shape[0]
+    _warm_basis(p, lo, hi, support)
+    m = 0
+    for k in range(n):
+        if support[k]:
+            support[m] = k
+            m += 1
+    A = room[:m * m].reshape((m, m))
+    x = room[m * m:m * m + m]
+    for a in range(m):
+        x[a] = -qq[support[a]]
+        for b in range(m):
+            A[a, b] = M[support[a], support[b]]
+    if not _gauss_solve(A, x, m):
+        return False
+    for k in range(n):
+        z[k] = 0.0
+    for a in range(m):
+        if x[a] < -WARM_FEASIBILITY_TOL:
+            return False
+        z[support[a]] = max(x[a], 0.0)
+    for i in range(n):  # w_i off S (on S it is zero by the solve)
+        w = qq[i]
+        for a in range(m):
+            w += M[i, support[a]] * x[a]
+        if w < -WARM_FEASIBILITY_TOL:
+            return False
+    return True
+
+
+@jit_borrowing
+def _gauss_solve(A, x, m):
+    """A y = x for y, in place in x (A overwritten): Gaussian elimination with partial pivoting.
+    False when a pivot is below PIVOT_TOL times its column's max (≥ 1): A singular to round-off."""
+    for c in range(m):
+        r, column_max = c, 0.0
+        for i in range(c, m):
+            if abs(A[i, c]) > abs(A[r, c]):
+                r = i
+            column_max = max(column_max, abs(A[i, c]))
+        if abs(A[r, c]) <= PIVOT_TOL * max(column_max, 1.0):
+            return False
+        if r != c:
+            for j in range(m):
+                A[c, j], A[r, j] = A[r, j], A[c, j]
+            x[c], x[r] = x[r], x[c]
+        for i in range(c + 1, m):
+            factor = A[i, c] / A[c, c]
+            if factor != 0.0:
+                for j in range(c + 1, m):
+                    A[i, j] -= factor * A[c, j]
+                x[i] -= factor * x[c]
+    for c in range(m - 1, -1, -1):
+        value = x[c]
+        for j in range(c + 1, m):
+            value -= A[c, j] * x[j]
+        x[c] = value / A[c, c]
+    return True
 
 
 @jit_borrowing
