@@ -435,7 +435,7 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
         _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     status, pivots = SOLVED, 0
     warm = warm_tol > 0.0 and formulation == INTERVAL and _warm_solution(
-        M, qq, p, lo, hi, floats[tableau_at:tableau_at + n * n + n], ints[n:2 * n], z)
+        M, qq, p, lo, hi, floats[tableau_at:tableau_at + n * n + 2 * n], ints[n:3 * n], z)
     if warm:  # (the tableau's room holds the warm solve's n × n system: the cold path refills it)
         residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
         warm = residual <= warm_tol * scale
@@ -492,11 +492,13 @@ def _warm_basis(p, lo, hi, basic):
 @jit_borrowing
 def _warm_solution(M, qq, p, lo, hi, room, support, z):
     """z of the basis the warm start p sits at (_warm_basis) when that basis is feasible for
-    (M, qq): M_SS z_S = −qq_S on its basic set S (Gaussian elimination, partial pivoting), z_S ≥ 0
-    and w = M z + qq ≥ 0 off S, to WARM_FEASIBILITY_TOL. False — Lemke then pivots from scratch —
-    when M_SS is singular (PIVOT_TOL, as Lemke's pivots) or the basis is infeasible. The answer
-    is then complementary by construction: one of w_k, z_k is zero for each k.
-    room: n² + n floats of scratch; support: n ints."""
+    (M, qq): M_SS z_S = −qq_S on its basic set S (LU with partial pivoting, one step of iterative
+    refinement against M as `_basic_solution` makes: without it a held body's round-off wandered
+    in a cycle of four steps, which the loop's exact-rest test does not take), z_S ≥ 0 and
+    w = M z + qq ≥ 0 off S, to WARM_FEASIBILITY_TOL. False — Lemke then pivots from scratch — when
+    M_SS is singular (PIVOT_TOL, as Lemke's pivots) or the basis is infeasible. The answer is then
+    complementary by construction: one of w_k, z_k is zero for each k.
+    room: n² + 2n floats of scratch; support: 2n ints."""
     n = qq.shape[0]
     _warm_basis(p, lo, hi, support)
     m = 0
@@ -505,16 +507,24 @@ def _warm_solution(M, qq, p, lo, hi, room, support, z):
             support[m] = k
             m += 1
     A = room[:m * m].reshape((m, m))
-    x = room[m * m:m * m + m]
+    x, correction, rows = room[m * m:m * m + m], room[m * m + m:m * m + 2 * m], support[n:n + m]
     for a in range(m):
         x[a] = -qq[support[a]]
         for b in range(m):
             A[a, b] = M[support[a], support[b]]
-    if not _gauss_solve(A, x, m):
+    if not _lu_factor(A, m, rows):
         return False
+    _lu_solve(A, m, rows, x)
+    for a in range(m):  # the refinement: the residual of the original rows, solved again
+        value = -qq[support[a]]
+        for b in range(m):
+            value -= M[support[a], support[b]] * x[b]
+        correction[a] = value
+    _lu_solve(A, m, rows, correction)
     for k in range(n):
         z[k] = 0.0
     for a in range(m):
+        x[a] += correction[a]
         if x[a] < -WARM_FEASIBILITY_TOL:
             return False
         z[support[a]] = max(x[a], 0.0)
@@ -528,33 +538,45 @@ def _warm_solution(M, qq, p, lo, hi, room, support, z):
 
 
 @jit_borrowing
-def _gauss_solve(A, x, m):
-    """A y = x for y, in place in x (A overwritten): Gaussian elimination with partial pivoting.
-    False when a pivot is below PIVOT_TOL times its column's max (≥ 1): A singular to round-off."""
+def _lu_factor(A, m, rows):
+    """A = P L U in place (L's multipliers below the diagonal, rows[c]: the row swapped into c),
+    partial pivoting; False when the largest pivot left is below PIVOT_TOL: A singular to round-off."""
     for c in range(m):
-        r, column_max = c, 0.0
-        for i in range(c, m):
+        r = c
+        for i in range(c + 1, m):
             if abs(A[i, c]) > abs(A[r, c]):
                 r = i
-            column_max = max(column_max, abs(A[i, c]))
-        if abs(A[r, c]) <= PIVOT_TOL * max(column_max, 1.0):
+        if abs(A[r, c]) <= PIVOT_TOL:  # (M's data are normalised to max |entry| ~ 1, as for Lemke's pivots)
             return False
+        rows[c] = r
         if r != c:
             for j in range(m):
                 A[c, j], A[r, j] = A[r, j], A[c, j]
-            x[c], x[r] = x[r], x[c]
         for i in range(c + 1, m):
             factor = A[i, c] / A[c, c]
+            A[i, c] = factor
             if factor != 0.0:
                 for j in range(c + 1, m):
                     A[i, j] -= factor * A[c, j]
-                x[i] -= factor * x[c]
+    return True
+
+
+@jit_borrowing
+def _lu_solve(A, m, rows, x):
+    """x ← A⁻¹ x with A factored by _lu_factor (its swaps moved whole rows, L's multipliers too:
+    all of them apply to x first)."""
+    for c in range(m):
+        r = rows[c]
+        if r != c:
+            x[c], x[r] = x[r], x[c]
+    for c in range(m):
+        for i in range(c + 1, m):
+            x[i] -= A[i, c] * x[c]
     for c in range(m - 1, -1, -1):
         value = x[c]
         for j in range(c + 1, m):
             value -= A[c, j] * x[j]
         x[c] = value / A[c, c]
-    return True
 
 
 @jit_borrowing
