@@ -54,7 +54,7 @@ from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit, jit_borrowing
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
-from .kernel_base import carve, carve_matrix, solver_scratch, step_residual
+from .kernel_base import carve, carve_matrix, problem_scale, solver_scratch, step_residual
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -86,12 +86,9 @@ TIE_TOL = 1e-14
 # Accept a friction solution when complementarity_residual ≤ RESIDUAL_TOL · residual_scale.
 RESIDUAL_TOL = 1e-9
 
-# The warm start (_warm_solution): a tangential impulse within this fraction of the friction
-# interval's reach (max(|lo|, |hi|) p_N) of one of its ends counts as at that end; a basic value
-# (or a non-basic w) below −WARM_FEASIBILITY_TOL (normalised units, as PIVOT_TOL) makes the basis
-# infeasible for the new problem, and Lemke pivots from scratch.
+# The warm start (warm_interval_answer): a tangential impulse within this fraction of the friction
+# interval's reach (max(|lo|, |hi|) p_N) of one of its ends counts as at that end.
 WARM_BOUND_TOL = 1e-9
-WARM_FEASIBILITY_TOL = 1e-12
 
 
 # The pivoting and its helpers are compiled without reference counting (_jit.jit_borrowing): they
@@ -386,12 +383,12 @@ def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
     floats, ints = solver_scratch(len(lo))
     p, u = np.empty(2 * len(lo)), np.empty(2 * len(lo))
     residual, status, pivots, q_norm, W_norm, scale = _lemke_friction_into(W, q, lo, hi, max_pivots, formulation,
-                                                                          floats, ints, p, u, 0.0)
+                                                                          floats, ints, p, u)
     return p, u, residual, status, pivots, (q_norm, W_norm, scale)
 
 
 @jit_borrowing
-def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p, u, warm_tol):
+def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p, u):
     """Friction step → lifted LCP → Lemke → p, u (2 len(lo) each, written) and (residual,
     status, pivots, ‖q‖∞, max|W|, max(‖p‖∞, ‖u‖∞, ‖q‖∞)) — the norms for the acceptance test
     and the contact states (computed here, they cost nothing; in Python after the call,
@@ -404,12 +401,8 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     leaves its friction interval as it is; d_c a power of two near 1/√W_cc: exact), then
     divided by max|D W D| and max|D q|, so that the pivoting tolerances act on O(1) numbers
     even when the contacts' W blocks differ by 1e12 (a heavy and a light body); p = D p̃ ·
-    max|D q| / max|D W D| undoes it exactly.
-
-    ``warm_tol`` > 0 (the interval LCP only): p on entry is a warm start — the previous step's
-    impulses, or the sign iteration's previous solve — and the complementary basis it sits at
-    is tried first (_warm_solution: one small solve, no pivot); its answer is taken when it
-    passes the solver's own test, residual ≤ warm_tol · scale, else Lemke pivots from scratch.
+    max|D q| / max|D W D| undoes it exactly. (The step's warm start, `warm_interval_answer`, is
+    tried before it, on W itself.)
     """
     n_c = len(lo)
     per_contact = 3 if formulation == INTERVAL else 4
@@ -419,7 +412,6 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     qs, at = carve(floats, at, 2 * n_c)
     M, at = carve_matrix(floats, at, n, n)
     qq, at = carve(floats, at, n)
-    tableau_at = at
     T, at = carve_matrix(floats, at, n, 2 * n + 2)
     z, at = carve(floats, at, n)
     refine, at = carve(floats, at, n)
@@ -433,15 +425,8 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
         _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
         _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
-    status, pivots = SOLVED, 0
-    warm = warm_tol > 0.0 and formulation == INTERVAL and _warm_solution(
-        M, qq, p, lo, hi, floats[tableau_at:tableau_at + n * n + 2 * n], ints[n:3 * n], z)
-    if warm:  # (the tableau's room holds the warm solve's n × n system: the cold path refills it)
-        residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
-        warm = residual <= warm_tol * scale
-    if not warm:
-        status, pivots, _ = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)  # (z = 0 unless solved)
-        residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
+    status, pivots, _ = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)  # (z = 0 unless solved)
+    residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
     if status == RAY:
         # Wedged contacts (two normals nearly opposed, W singular) make the solution set
         # unbounded, and Lemke may leave on a ray with z0 ~ 1e-11 instead of 0: the point it
@@ -490,16 +475,19 @@ def _warm_basis(p, lo, hi, basic):
 
 
 @jit_borrowing
-def _warm_solution(M, qq, p, lo, hi, room, support, z):
-    """z of the basis the warm start p sits at (_warm_basis) when that basis is feasible for
-    (M, qq): M_SS z_S = −qq_S on its basic set S (LU with partial pivoting, one step of iterative
-    refinement against M as `_basic_solution` makes: without it a held body's round-off wandered
-    in a cycle of four steps, which the loop's exact-rest test does not take), z_S ≥ 0 and
-    w = M z + qq ≥ 0 off S, to WARM_FEASIBILITY_TOL. False — Lemke then pivots from scratch — when
-    M_SS is singular (PIVOT_TOL, as Lemke's pivots) or the basis is infeasible. The answer is then
-    complementary by construction: one of w_k, z_k is zero for each k.
-    room: n² + 2n floats of scratch; support: 2n ints."""
-    n = qq.shape[0]
+def warm_interval_answer(W, q, lo, hi, p, u, rtol, room, support):
+    """The step's answer at the basis its warm start p sits at, or −1 (p, u then garbage: the caller
+    pivots from scratch). p on entry: the previous step's impulses of the contacts that stay closed,
+    or the sign iteration's previous solve. The interval LCP's basic set S of p (_warm_basis) is
+    solved alone — M_SS z_S = −q_S, its entries read from W (`_interval_entry`, unscaled), LU with
+    partial pivoting and one step of iterative refinement (without it a held ladder's round-off
+    wandered in a cycle of four steps, which the loop's exact-rest test does not take) — and its
+    p, u = W p + q are returned (the residual) when they pass Lemke's own acceptance, the
+    residual ≤ rtol · max(‖q‖∞, ‖p‖∞, ‖u‖∞): no tableau, no scaling, no pivot. −1 when M_SS is
+    singular (a pivot ≤ PIVOT_TOL · max|M_SS|: both corners of a block strictly inside their
+    intervals, the segment's interior) or the answer misses the law (the basis is infeasible now).
+    room: n² + 2n floats, support: 2n ints, n = 3 len(lo). Borrowing: it allocates nothing."""
+    n = 3 * lo.shape[0]
     _warm_basis(p, lo, hi, support)
     m = 0
     for k in range(n):
@@ -508,45 +496,67 @@ def _warm_solution(M, qq, p, lo, hi, room, support, z):
             m += 1
     A = room[:m * m].reshape((m, m))
     x, correction, rows = room[m * m:m * m + m], room[m * m + m:m * m + 2 * m], support[n:n + m]
+    largest = 0.0
     for a in range(m):
-        x[a] = -qq[support[a]]
+        x[a] = -_interval_q(q, support[a])
         for b in range(m):
-            A[a, b] = M[support[a], support[b]]
-    if not _lu_factor(A, m, rows):
-        return False
+            A[a, b] = _interval_entry(W, lo, hi, support[a], support[b])
+            largest = max(largest, abs(A[a, b]))
+    if not _lu_factor(A, m, rows, PIVOT_TOL * largest):
+        return -1.0
     _lu_solve(A, m, rows, x)
     for a in range(m):  # the refinement: the residual of the original rows, solved again
-        value = -qq[support[a]]
+        value = -_interval_q(q, support[a])
         for b in range(m):
-            value -= M[support[a], support[b]] * x[b]
+            value -= _interval_entry(W, lo, hi, support[a], support[b]) * x[b]
         correction[a] = value
     _lu_solve(A, m, rows, correction)
-    for k in range(n):
-        z[k] = 0.0
+    for r in range(2 * lo.shape[0]):
+        p[r] = 0.0
     for a in range(m):
-        x[a] += correction[a]
-        if x[a] < -WARM_FEASIBILITY_TOL:
-            return False
-        z[support[a]] = max(x[a], 0.0)
-    for i in range(n):  # w_i off S (on S it is zero by the solve)
-        w = qq[i]
-        for a in range(m):
-            w += M[i, support[a]] * x[a]
-        if w < -WARM_FEASIBILITY_TOL:
-            return False
-    return True
+        k = support[a]
+        value = x[a] + correction[a]
+        if k % 3 == 0:
+            p[2 * (k // 3)] += value
+            p[2 * (k // 3) + 1] += lo[k // 3] * value
+        elif k % 3 == 1:
+            p[2 * (k // 3) + 1] += value
+    residual = step_residual(W, q, lo, hi, p, u)
+    return residual if residual <= rtol * problem_scale(q, p, u) else -1.0
 
 
 @jit_borrowing
-def _lu_factor(A, m, rows):
+def _interval_q(q, r):
+    """Entry r of the interval LCP's q (unscaled): (q_N, q_T, 0) per contact."""
+    return q[2 * (r // 3) + r % 3] if r % 3 < 2 else 0.0
+
+
+@jit_borrowing
+def _interval_entry(W, lo, hi, r, c):
+    """Entry (r, c) of the interval LCP's M (module docstring), unscaled, read from W."""
+    i, row_kind, j, column_kind = r // 3, r % 3, c // 3, c % 3
+    if row_kind == 2:  # (hi − lo) p_N − β
+        if i != j:
+            return 0.0
+        return hi[i] - lo[i] if column_kind == 0 else (-1.0 if column_kind == 1 else 0.0)
+    if column_kind == 2:  # σ enters u_T + σ of its own contact
+        return 1.0 if row_kind == 1 and i == j else 0.0
+    row = 2 * i + row_kind
+    if column_kind == 0:
+        return W[row, 2 * j] + lo[j] * W[row, 2 * j + 1]
+    return W[row, 2 * j + 1]
+
+
+@jit_borrowing
+def _lu_factor(A, m, rows, pivot_tol):
     """A = P L U in place (L's multipliers below the diagonal, rows[c]: the row swapped into c),
-    partial pivoting; False when the largest pivot left is below PIVOT_TOL: A singular to round-off."""
+    partial pivoting; False when the largest pivot left is ≤ pivot_tol: A singular to round-off."""
     for c in range(m):
         r = c
         for i in range(c + 1, m):
             if abs(A[i, c]) > abs(A[r, c]):
                 r = i
-        if abs(A[r, c]) <= PIVOT_TOL:  # (M's data are normalised to max |entry| ~ 1, as for Lemke's pivots)
+        if abs(A[r, c]) <= pivot_tol:
             return False
         rows[c] = r
         if r != c:
