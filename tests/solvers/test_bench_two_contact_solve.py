@@ -55,3 +55,28 @@ def test_the_toys_timed_pairs_stick_with_a_segment_of_answers():
             t_low = max(lo[0] * p[0] - p[1], p[3] - hi[1] * p[2])
             t_high = min(hi[0] * p[0] - p[1], p[3] - lo[1] * p[2])
             assert t_high - t_low > 1e-3 * np.abs(p).max(), name
+
+
+def test_the_toys_problems_warm_started_from_the_last_answer_take_no_pivot_and_the_same_velocities():
+    """Along each two-corner toy's run, each coupled-pair problem solved by the step's Lemke
+    (kernels.solve_interval) from the previous problem's answer — what the step's warm start does —
+    takes the previous basis (no pivot) on all but the first, and gives the velocities u of the cold
+    solve (lemke_friction), to round-off of the problem's scale: the split between the corners
+    may be another end of the segment of answers, the velocities are determined."""
+    from nonsmooth_rod.solvers.kernels import DEFAULT_RTOL, KERNEL_SOLVED, SOLVER_LEMKE, solve_interval
+    from nonsmooth_rod.solvers.lemke import lemke_friction
+    from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity_residual, residual_scale
+
+    for name in ("BlockOnIncline", "PushedBlock", "BeltOscillator"):
+        Ws, qs, los, his = _bench().two_contact_problems(getattr(toys, name)())
+        p, warm = np.zeros(4), 0
+        for W, q, lo, hi in zip(Ws, qs, los, his):
+            problem = PlanarFrictionProblem(W, q, lo, hi)
+            cold = lemke_friction(problem, fallback=False)
+            u = np.zeros(4)
+            status, pivots, residual = solve_interval(SOLVER_LEMKE, W, q, lo, hi, p, u, 0.0, 0)
+            scale = residual_scale(problem, p, u)
+            assert status == KERNEL_SOLVED and complementarity_residual(problem, p) <= DEFAULT_RTOL * scale
+            np.testing.assert_allclose(u, cold.u, rtol=0, atol=1e-12 * scale, err_msg=name)
+            warm += pivots == 0 < cold.iterations
+        assert warm == len(Ws) - 1, name

@@ -54,7 +54,12 @@ def test_every_kernel_solves_the_step_law(code, problem):
 def test_lemke_kernel_is_lemke_friction(problem):
     status, pivots, residual, p, u = run(SOLVER_LEMKE, problem)
     reference = lemke_friction(problem)
-    assert status == KERNEL_SOLVED and pivots == reference.iterations
+    assert status == KERNEL_SOLVED
+    if pivots == 0 and reference.iterations > 0:
+        # the warm start p = 0 (every contact open) answered: u = q solves the law within its acceptance
+        assert np.all(p == 0.0) and residual <= kernels.DEFAULT_RTOL * residual_scale(problem, p, u)
+        return
+    assert pivots == reference.iterations
     # the same pivots; compiled and interpreted arithmetic may differ by FMA and summation order
     scale = residual_scale(problem, reference.p, reference.u)
     np.testing.assert_allclose(p, reference.p, rtol=0, atol=500 * np.finfo(float).eps * scale)

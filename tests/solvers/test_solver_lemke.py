@@ -249,3 +249,70 @@ def test_contacts_of_very_different_stiffness_are_solved(ratio):
     problem = PlanarFrictionProblem(W, np.array([-1.0, 0.0, -1.0, 0.0]), np.array([-0.3, -0.3]), np.array([0.3, 0.3]))
     solution = solve(problem, "lemke")
     np.testing.assert_allclose(solution.p, [1.0, 0.0, 1.0 / ratio, 0.0], rtol=1e-12, atol=1e-12)
+
+
+# ---------------------------------------------------------------- the warm start (kernels.lemke_interval)
+def _kernel_solve(problem, p_start):
+    """The compiled step's Lemke (kernels.solve_interval, its default acceptance) from warm start p_start:
+    (status, pivots, residual, p, u)."""
+    from nonsmooth_rod.solvers.kernels import SOLVER_LEMKE, solve_interval
+
+    p, u = np.array(p_start, dtype=float), np.zeros_like(problem.q)
+    status, pivots, residual = solve_interval(SOLVER_LEMKE, problem.W, problem.q, problem.lo, problem.hi, p, u,
+                                              0.0, 0)
+    return int(status), int(pivots), float(residual), p, u
+
+
+def test_a_warm_start_at_the_answer_takes_no_pivot_and_gives_the_same_answer():
+    """Started from the cold answer's impulses (as a step at rest is from the previous step's), the
+    kernel takes the basis they sit at: zero pivots on every random 1–2 contact step, the same
+    answer (the basis is the same, so is its solution), within the solver's own acceptance."""
+    from nonsmooth_rod.solvers.kernels import DEFAULT_RTOL, KERNEL_SOLVED
+
+    rng = np.random.default_rng(25)
+    warm = 0
+    for trial in range(400):
+        problem = random_step(rng, 1 + trial % 2)
+        cold = lemke_friction(problem, fallback=False)
+        status, pivots, residual, p, u = _kernel_solve(problem, cold.p)
+        scale = residual_scale(problem, p, u)
+        assert status == KERNEL_SOLVED
+        assert residual == pytest.approx(complementarity_residual(problem, p), abs=1e-13 * scale)
+        assert residual <= DEFAULT_RTOL * scale
+        np.testing.assert_allclose(u, problem.W @ p + problem.q, rtol=0, atol=1e-13 * scale)
+        if pivots == 0 and cold.iterations > 0:
+            warm += 1
+            np.testing.assert_allclose(p, cold.p, rtol=0, atol=1e-9 * scale)
+            np.testing.assert_allclose(u, cold.u, rtol=0, atol=1e-9 * scale)
+    assert warm >= 330  # (342 of 400: the other 58 have q ≥ 0, which the cold pivoting answers with none too)
+
+
+def test_a_warm_start_that_no_longer_holds_falls_back_to_pivoting():
+    """The block sticks on both corners at 10° with μ = 0.5; at 40° it slides: the stuck basis is
+    infeasible for the steeper problem (its tangential impulse beyond μ p_N), so Lemke pivots from
+    scratch and gives the cold answer exactly."""
+    from nonsmooth_rod.solvers.kernels import KERNEL_SOLVED
+
+    stuck = lemke_friction(block_on_incline(np.radians(10.0), 0.5))
+    assert stuck.info["states"] == ["stick", "stick"]
+    steep = block_on_incline(np.radians(40.0), 0.5)
+    cold = lemke_friction(steep, fallback=False)
+    status, pivots, _, p, u = _kernel_solve(steep, stuck.p)
+    assert status == KERNEL_SOLVED and pivots == cold.iterations > 0
+    scale = residual_scale(steep, p, u)
+    np.testing.assert_allclose(p, cold.p, rtol=0, atol=1e-12 * scale)
+    assert cold.info["states"] == ["slip-", "slip-"] or cold.info["states"] == ["slip+", "slip+"]
+
+
+def test_a_stuck_block_warm_started_from_its_own_vertex_keeps_it():
+    """Both corners stuck: the answers are a segment (W d = 0 along d = (0, 1, 0, −1)). Lemke's
+    answer is an end of it (one corner's tangential impulse at a friction bound); the warm start
+    from it stays at that end, with no pivot, and every answer has the same velocities u."""
+    problem = block_on_incline(np.radians(10.0), 0.5)
+    cold = lemke_friction(problem, fallback=False)
+    status, pivots, _, p, u = _kernel_solve(problem, cold.p)
+    assert pivots == 0 < cold.iterations
+    scale = residual_scale(problem, p, u)
+    np.testing.assert_allclose(p, cold.p, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(u, cold.u, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(u[1::2], 0.0, atol=1e-12 * scale)  # stuck

@@ -7,7 +7,8 @@ the friction interval [lo_i p_N, hi_i p_N] of `problem.PlanarFrictionProblem`::
 
 (`solve_interval_into`: the same in a caller's scratch; the codes are registry.SOLVERS')
 
-fills p and u = W p + q in place (p is also pgs's warm start) and returns a status code,
+fills p and u = W p + q in place (p on entry is the warm start: pgs's first iterate, the basis
+Lemke tries first) and returns a status code,
 the solver's iterations (Lemke pivots, pgs sweeps, enum combinations) and the common
 complementarity residual. ``rtol`` is the tolerance on that residual relative to the
 problem's scale max(‖q‖∞, ‖p‖∞, ‖u‖∞); ``rtol ≤ 0`` takes the solver's default (Lemke and
@@ -31,7 +32,7 @@ from .._jit import jit, jit_borrowing
 from .enumeration import enum_interval
 from .delassus import dense_to_blocks
 from .gauss_seidel import pgs_block, pgs_block_into, pgs_dense, pgs_dense_into
-from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into
+from .lemke import CONE, INTERVAL, RAY, SOLVED, default_max_pivots, _lemke_friction_into, warm_interval_answer
 
 from .kernel_base import (
     DEFAULT_RTOL,
@@ -65,12 +66,18 @@ from .kernel_base import (
 def lemke_interval(W, q, lo, hi, p, u, rtol, max_pivots, floats, ints):
     """Lemke on the interval LCP, then on the cone LCP if that fails (as lemke_friction does),
     in the scratch (floats, ints) (kernel_base.solver_scratch of ≥ lo.shape[0] contacts).
+    p on entry is the warm start: the basis of the interval LCP it sits at is tried first
+    (lemke.warm_interval_answer: zero pivots when that basis still solves the problem to rtol).
 
     Returns (status, pivots, residual); the first formulation's failure status when both fail.
     Compiled without reference counting (the step's hot path; it allocates nothing).
     """
     if rtol <= 0.0:
         rtol = DEFAULT_RTOL
+    n = 3 * lo.shape[0]  # (the warm start's room: the cold path's scratch, which it then refills)
+    residual = warm_interval_answer(W, q, lo, hi, p, u, rtol, floats[:n * n + 2 * n], ints[:2 * n])
+    if residual >= 0.0:
+        return KERNEL_SOLVED, 0, residual
     first_status = KERNEL_SOLVED
     pivots = 0
     residual = 0.0

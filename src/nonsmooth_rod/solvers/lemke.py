@@ -54,7 +54,7 @@ from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit, jit_borrowing
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
-from .kernel_base import carve, carve_matrix, solver_scratch, step_residual
+from .kernel_base import carve, carve_matrix, problem_scale, solver_scratch, step_residual
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -85,6 +85,10 @@ TIE_TOL = 1e-14
 
 # Accept a friction solution when complementarity_residual ≤ RESIDUAL_TOL · residual_scale.
 RESIDUAL_TOL = 1e-9
+
+# The warm start (warm_interval_answer): a tangential impulse within this fraction of the friction
+# interval's reach (max(|lo|, |hi|) p_N) of one of its ends counts as at that end.
+WARM_BOUND_TOL = 1e-9
 
 
 # The pivoting and its helpers are compiled without reference counting (_jit.jit_borrowing): they
@@ -397,7 +401,8 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     leaves its friction interval as it is; d_c a power of two near 1/√W_cc: exact), then
     divided by max|D W D| and max|D q|, so that the pivoting tolerances act on O(1) numbers
     even when the contacts' W blocks differ by 1e12 (a heavy and a light body); p = D p̃ ·
-    max|D q| / max|D W D| undoes it exactly.
+    max|D q| / max|D W D| undoes it exactly. (The step's warm start, `warm_interval_answer`, is
+    tried before it, on W itself.)
     """
     n_c = len(lo)
     per_contact = 3 if formulation == INTERVAL else 4
@@ -420,22 +425,8 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
         _fill_interval_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
     else:
         _fill_cone_lcp(M, qq, Ws, qs, lo, hi, w_scale, q_scale)
-    status, pivots, entering = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)
-
-    for i in range(2 * n_c):
-        p[i], u[i] = 0.0, 0.0
-    residual = 0.0
-    if status == SOLVED or status == RAY:
-        for j in range(n_c):
-            to_impulse = d[j] * q_scale / w_scale
-            k = per_contact * j
-            p[2 * j] = z[k] * to_impulse
-            if formulation == INTERVAL:
-                p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
-            else:
-                p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
-        residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
-    scale = max(q_norm, _max_abs(p), _max_abs(u))
+    status, pivots, _ = _lemke_kernel(M, qq, max_pivots, T, ints[:n], z, refine)  # (z = 0 unless solved)
+    residual, scale = _impulses_of(z, d, q_scale / w_scale, formulation, W, q, lo, hi, q_norm, p, u)
     if status == RAY:
         # Wedged contacts (two normals nearly opposed, W singular) make the solution set
         # unbounded, and Lemke may leave on a ray with z0 ~ 1e-11 instead of 0: the point it
@@ -443,6 +434,159 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
         if residual <= RESIDUAL_TOL * (scale if scale > 0.0 else 1.0):
             status = SOLVED
     return residual, status, pivots, q_norm, W_norm, scale
+
+
+@jit_borrowing
+def _impulses_of(z, d, to_units, formulation, W, q, lo, hi, q_norm, p, u):
+    """p from the LCP's z (per contact d_c · to_units undoes the scaling), u = W p + q:
+    (residual, max(‖q‖∞, ‖p‖∞, ‖u‖∞)). z = 0 gives p = 0, u = q."""
+    per_contact = 3 if formulation == INTERVAL else 4
+    for j in range(len(lo)):
+        to_impulse = d[j] * to_units
+        k = per_contact * j
+        p[2 * j] = z[k] * to_impulse
+        if formulation == INTERVAL:
+            p[2 * j + 1] = (lo[j] * z[k] + z[k + 1]) * to_impulse
+        else:
+            p[2 * j + 1] = (hi[j] * z[k + 1] + lo[j] * z[k + 2]) * to_impulse
+    residual = step_residual(W, q, lo, hi, p, u)  # u = W p + q, problem.py's residual
+    return residual, max(q_norm, _max_abs(p), _max_abs(u))
+
+
+@jit_borrowing
+def _warm_basis(p, lo, hi, basic):
+    """The complementary basis of the interval LCP that the impulses p sit at: basic[k] = 1
+    when z_k is basic (else its w_k is). Per contact (p_N, β, σ): p_N basic when p_N > 0; β
+    basic unless p_T is at the interval's low end (β = 0); σ basic when p_T is at its high end
+    (slip −, or a stick there). A non-finite or non-positive p_N: the contact open, all w basic."""
+    for j in range(len(lo)):
+        k = 3 * j
+        p_n, p_t = p[2 * j], p[2 * j + 1]
+        basic[k], basic[k + 1], basic[k + 2] = 0, 0, 0
+        if not (p_n > 0.0 and np.isfinite(p_n) and np.isfinite(p_t)):
+            continue
+        basic[k] = 1
+        tol = WARM_BOUND_TOL * max(abs(lo[j]), abs(hi[j])) * p_n
+        beta, width = p_t - lo[j] * p_n, (hi[j] - lo[j]) * p_n
+        if beta > tol:
+            basic[k + 1] = 1
+            if beta >= width - tol:
+                basic[k + 2] = 1
+
+
+@jit_borrowing
+def warm_interval_answer(W, q, lo, hi, p, u, rtol, room, support):
+    """The step's answer at the basis its warm start p sits at, or −1 (p, u then garbage: the caller
+    pivots from scratch). p on entry: the previous step's impulses of the contacts that stay closed,
+    or the sign iteration's previous solve. The interval LCP's basic set S of p (_warm_basis) is
+    solved alone — M_SS z_S = −q_S, its entries read from W (`_interval_entry`, unscaled), LU with
+    partial pivoting and one step of iterative refinement (without it a held ladder's round-off
+    wandered in a cycle of four steps, which the loop's exact-rest test does not take) — and its
+    p, u = W p + q are returned (the residual) when they pass Lemke's own acceptance, the
+    residual ≤ rtol · max(‖q‖∞, ‖p‖∞, ‖u‖∞): no tableau, no scaling, no pivot. −1 when M_SS is
+    singular (a pivot ≤ PIVOT_TOL · max|M_SS|: both corners of a block strictly inside their
+    intervals, the segment's interior) or the answer misses the law (the basis is infeasible now).
+    room: n² + 2n floats, support: 2n ints, n = 3 len(lo). Borrowing: it allocates nothing."""
+    n = 3 * lo.shape[0]
+    _warm_basis(p, lo, hi, support)
+    m = 0
+    for k in range(n):
+        if support[k]:
+            support[m] = k
+            m += 1
+    A = room[:m * m].reshape((m, m))
+    x, correction, rows = room[m * m:m * m + m], room[m * m + m:m * m + 2 * m], support[n:n + m]
+    largest = 0.0
+    for a in range(m):
+        x[a] = -_interval_q(q, support[a])
+        for b in range(m):
+            A[a, b] = _interval_entry(W, lo, hi, support[a], support[b])
+            largest = max(largest, abs(A[a, b]))
+    if not _lu_factor(A, m, rows, PIVOT_TOL * largest):
+        return -1.0
+    _lu_solve(A, m, rows, x)
+    for a in range(m):  # the refinement: the residual of the original rows, solved again
+        value = -_interval_q(q, support[a])
+        for b in range(m):
+            value -= _interval_entry(W, lo, hi, support[a], support[b]) * x[b]
+        correction[a] = value
+    _lu_solve(A, m, rows, correction)
+    for r in range(2 * lo.shape[0]):
+        p[r] = 0.0
+    for a in range(m):
+        k = support[a]
+        value = x[a] + correction[a]
+        if k % 3 == 0:
+            p[2 * (k // 3)] += value
+            p[2 * (k // 3) + 1] += lo[k // 3] * value
+        elif k % 3 == 1:
+            p[2 * (k // 3) + 1] += value
+    residual = step_residual(W, q, lo, hi, p, u)
+    return residual if residual <= rtol * problem_scale(q, p, u) else -1.0
+
+
+@jit_borrowing
+def _interval_q(q, r):
+    """Entry r of the interval LCP's q (unscaled): (q_N, q_T, 0) per contact."""
+    return q[2 * (r // 3) + r % 3] if r % 3 < 2 else 0.0
+
+
+@jit_borrowing
+def _interval_entry(W, lo, hi, r, c):
+    """Entry (r, c) of the interval LCP's M (module docstring), unscaled, read from W."""
+    i, row_kind, j, column_kind = r // 3, r % 3, c // 3, c % 3
+    if row_kind == 2:  # (hi − lo) p_N − β
+        if i != j:
+            return 0.0
+        return hi[i] - lo[i] if column_kind == 0 else (-1.0 if column_kind == 1 else 0.0)
+    if column_kind == 2:  # σ enters u_T + σ of its own contact
+        return 1.0 if row_kind == 1 and i == j else 0.0
+    row = 2 * i + row_kind
+    if column_kind == 0:
+        return W[row, 2 * j] + lo[j] * W[row, 2 * j + 1]
+    return W[row, 2 * j + 1]
+
+
+@jit_borrowing
+def _lu_factor(A, m, rows, pivot_tol):
+    """A = P L U in place (L's multipliers below the diagonal, rows[c]: the row swapped into c),
+    partial pivoting; False when the largest pivot left is ≤ pivot_tol: A singular to round-off."""
+    for c in range(m):
+        r = c
+        for i in range(c + 1, m):
+            if abs(A[i, c]) > abs(A[r, c]):
+                r = i
+        if abs(A[r, c]) <= pivot_tol:
+            return False
+        rows[c] = r
+        if r != c:
+            for j in range(m):
+                A[c, j], A[r, j] = A[r, j], A[c, j]
+        for i in range(c + 1, m):
+            factor = A[i, c] / A[c, c]
+            A[i, c] = factor
+            if factor != 0.0:
+                for j in range(c + 1, m):
+                    A[i, j] -= factor * A[c, j]
+    return True
+
+
+@jit_borrowing
+def _lu_solve(A, m, rows, x):
+    """x ← A⁻¹ x with A factored by _lu_factor (its swaps moved whole rows, L's multipliers too:
+    all of them apply to x first)."""
+    for c in range(m):
+        r = rows[c]
+        if r != c:
+            x[c], x[r] = x[r], x[c]
+    for c in range(m):
+        for i in range(c + 1, m):
+            x[i] -= A[i, c] * x[c]
+    for c in range(m - 1, -1, -1):
+        value = x[c]
+        for j in range(c + 1, m):
+            value -= A[c, j] * x[j]
+        x[c] = value / A[c, c]
 
 
 @jit_borrowing
