@@ -84,6 +84,16 @@ def compile_share(share) -> None:
             pass
 
 
+def in_cache(share) -> bool:
+    """Every callee of `share` is in numba's cache already (the markers were lost, not the cache):
+    no helper is worth starting. False where that cannot be told."""
+    try:
+        return all(dispatcher._cache.load_overload(args, dispatcher.targetctx) is not None
+                   for dispatcher, args in share)
+    except Exception:  # noqa: BLE001 — numba's cache reached otherwise: split as if cold
+        return False
+
+
 def _start_helper(index: int, module: str, log: Path | None):
     """The helper process compiling share `index`: same interpreter, same package (its folder
     first on the path), same numba cache (the environment); in this process group, so a job
@@ -113,7 +123,7 @@ def compile_callees(log: Path | None = None, module: str = SHARES_MODULE) -> boo
     if usable_cores() < 2:
         return False
     split = shares(module)
-    if split is None or len(split) < 2:
+    if split is None or len(split) < 2 or in_cache(split[1]):
         return False
     try:
         helper = _start_helper(1, module, log)

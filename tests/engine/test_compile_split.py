@@ -53,6 +53,8 @@ def test_the_helper_compiles_its_share_into_the_cache_and_the_caller_finds_both(
     assert pair.caller(np.array([3.0])) == 15.0  # typing the caller asks for both
     assert pair.square.stats.cache_hits[sig] == 1 and not pair.square.stats.cache_misses  # found in the cache
     assert pair.double.stats.cache_misses[sig] == 1  # compiled once, by the share
+    log.unlink()
+    assert not _compile_split.compile_callees(log, module) and not log.exists()  # cached: no helper again
 
 
 def test_shares_that_cannot_be_rebuilt_or_one_core_split_nothing(tmp_path, monkeypatch):
