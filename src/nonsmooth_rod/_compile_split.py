@@ -32,11 +32,12 @@ CHAIN = (("nonsmooth_rod.integrators.moreau_jean_loop", "run_steps"),  # with _r
          ("nonsmooth_rod.solvers.two_coefficient", "_by_group_split"))
 
 # The helper's share, by function name (the rest of the loop's callees are this process's): the
-# hold search's subtree and the broad phase's, ~40 s of a cold compile on the 2-core machine against
-# ~40 s for the other share (pgs_or_lemke_into, solve_interval_into and the loop's small callees);
-# the chain after them is ~50 s (numba's compile events, docs/performance.md).
+# hold search's subtree, the broad phase's and the joints' begin and projection, ~45 s of CPU of a
+# cold compile on the 2-core machine, against ~45 s for the other share (pgs_or_lemke_into,
+# solve_interval_into and the loop's small callees); the chain after them is ~41 s (numba's compile
+# events, docs/performance.md). The helper also pays its start (~2 s), so it takes no more.
 HELPER_SHARE = frozenset({"_hold_search", "broad_candidates", "_joints_begin", "_joints_project"})
-HELPER_TIMEOUT_S = 900.0  # a helper that hangs is left behind: the loop compiles what is missing
+HELPER_TIMEOUT_S = 900.0  # a helper that hangs is killed: the loop compiles what is missing
 
 
 def usable_cores() -> int:
