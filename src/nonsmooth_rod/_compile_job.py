@@ -4,7 +4,8 @@
 runs with Python force callbacks; every exact solver is compiled into it) and
 `python -m nonsmooth_rod._compile_job --python-step SOLVER` (the step kernels around a Python
 solver) are what a cold run starts in the background (`_jit.compile_in_background`);
-`nonsmooth-rod compile` calls `warm_up`. Each part compiles under its lock and is marked when done.
+`nonsmooth-rod compile` calls `warm_up`. Each part compiles under its lock and is marked when done;
+the loop's callees compile on two cores first where there are two (`_compile_split`).
 """
 from __future__ import annotations
 

@@ -493,10 +493,12 @@ class _part_lock:
 class compiling:
     """Context manager around the first compiled call of `part` in a process: when the part is cold,
     says once what is compiled and how long it takes here, waits for any other process compiling it,
-    and afterwards marks the part compiled with the time it took."""
+    runs `prepare(log)` (the loop's callees compiled on two cores first: _compile_split; `log`, a
+    file beside the marker for a helper's output), and afterwards marks the part compiled with the
+    time it took."""
 
-    def __init__(self, part: str, what: str):
-        self.part, self.what = part, what
+    def __init__(self, part: str, what: str, prepare=None):
+        self.part, self.what, self.prepare = part, what, prepare
 
     def __enter__(self):
         self.cold = ENABLED and not engine_is_warm(self.part)
@@ -512,6 +514,8 @@ class compiling:
         _say(self.part, f"compiling {self.what} (once per install): ~{seconds:.0f} s "
                         f"{'as measured on this machine' if measured else 'estimated'}")
         self._start = time.perf_counter()
+        if self.prepare is not None:
+            self.prepare(_marker(self.part).with_suffix(".helper.log"))
         return self
 
     def __exit__(self, exc_type, exc, tb):

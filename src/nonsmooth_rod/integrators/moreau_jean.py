@@ -25,6 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
+from .._compile_split import compile_callees
 from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, C_SURFACE_VELOCITY, pack_scene
@@ -238,7 +239,10 @@ def compiled_part(solver: str, solver_code, callback: bool):
     the compiled loop."""
     if solver_code is None:
         return "moreau-jean-python-step", "the step kernels around Python solvers", ["--python-step", solver]
-    return "moreau-jean", _LOOP_IN_WORDS, []  # callbacks run it step by step
+    return LOOP_PART, _LOOP_IN_WORDS, []  # callbacks run it step by step
+
+
+LOOP_PART = "moreau-jean"
 
 
 _LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
@@ -279,7 +283,10 @@ class Engine:
 
     def compiling(self):
         """The compile notice and lock around a call of the compiled kernels (nothing when warm)."""
-        return _jit.compiling(self.part, self.what) if self.compiled else contextlib.nullcontext()
+        if not self.compiled:
+            return contextlib.nullcontext()
+        # the loop's callees compiled on two cores before it (_compile_split)
+        return _jit.compiling(self.part, self.what, prepare=compile_callees if self.part == LOOP_PART else None)
 
 
 class MoreauJean:

@@ -1221,7 +1221,7 @@ def end_of_step(k, status, counters):
     return status
 
 
-@jit
+@_inlined  # into run_steps: numba generates a callee's code again in each caller (a level: ~9 s of a cold compile)
 def _run(solver_code, k_start, k_end, params, iparams, model, work, out, extra):
     """Steps k_start … k_end − 1 with the packed forces (+ `extra`): the whole run in one call."""
     # what the loop needs besides the tuples, allocated here: run_arrays counts no references
