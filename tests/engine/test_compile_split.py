@@ -1,6 +1,9 @@
 """The loop's callees compiled on two cores before it (_compile_split), and the shipped shares kept
 equal to what the loop's typing asks for (_loop_callees)."""
+import os
+import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -45,6 +48,9 @@ def test_the_helper_compiles_its_share_into_the_cache_and_the_caller_finds_both(
                                                        f" (({name!r}, 'square', '(float64[::1],)'),))")
     monkeypatch.setattr(_compile_split, "usable_cores", lambda: 2)
     log = tmp_path / "helper.log"
+    monkeypatch.setattr(_compile_split, "free_cores", lambda: 1)  # the other core busy: no helper
+    assert not _compile_split.compile_callees(log, module) and not log.exists()
+    monkeypatch.setattr(_compile_split, "free_cores", lambda: 2)
     assert _compile_split.compile_callees(log, module)
     assert "compiled share 1" in log.read_text()
     pair = sys.modules[name]
@@ -96,3 +102,17 @@ def test_the_shipped_shares_are_what_the_loops_typing_asks_for():
     assert rebuilt is not None and all(hasattr(d, "compile") for share in rebuilt for d, _ in share)
     assert {(d.py_func.__name__, tuple(args)) for share in rebuilt for d, args in share} == \
         {(name, tuple(args)) for _, name, args in callees if _loop_callees.signature_text(args) is not None}
+
+
+def test_free_cores_sees_a_busy_core():
+    """A process spinning on one of this process's cores leaves it not free (/proc/stat's idle share)."""
+    cores = _compile_split.usable_cores()
+    if cores < 2 or not os.path.exists("/proc/stat"):
+        pytest.skip("needs two cores and /proc/stat")
+    spinner = subprocess.Popen([sys.executable, "-c", "import time\nt = time.time()\nwhile time.time() - t < 5: pass"])
+    try:
+        time.sleep(0.5)  # the spinner is running
+        assert _compile_split.free_cores(0.5) <= cores - 1
+    finally:
+        spinner.kill()
+        spinner.wait()
