@@ -159,7 +159,9 @@ def _module_attribute(module: str, name: str):
 def _kernel(function, options: dict):
     """numba's dispatcher of `function` when numba is loaded, else a LazyKernel standing for it."""
     if _numba is not None:
-        return _numba.njit(**options)(function)
+        dispatcher = _numba.njit(**options)(function)
+        _compile_once_across_processes(dispatcher)
+        return dispatcher
     kernel = LazyKernel(function, options)
     _lazy_kernels.append(kernel)
     return kernel
@@ -188,6 +190,7 @@ def _load_numba():
     _pending_jitable.clear()
     for kernel in _lazy_kernels:
         kernel.dispatcher = numba.njit(**kernel.options)(kernel.py_func)
+        _compile_once_across_processes(kernel.dispatcher)
     _numba = numba
     package = __name__.rpartition(".")[0]
     for name, module in list(sys.modules.items()):
@@ -198,6 +201,39 @@ def _load_numba():
                     space[key] = value.dispatcher
     _lazy_kernels.clear()
     return numba
+
+
+def _compile_once_across_processes(dispatcher) -> None:
+    """Make `dispatcher`'s compiles take a lock per kernel shared by the processes of this cache:
+    a second process (a test worker, a Dask worker on a fresh install) waits for the first and
+    then loads its kernel from the cache instead of compiling it again (measured: both workers of
+    a fresh test suite compiled the hold search's kernels at once, ~40 s of CPU each).
+
+    The file lock is taken inside numba's own compiler lock (re-entrant), so one thread of a
+    process holds kernel locks at a time, and a compile takes its callees' locks while holding its
+    own: the order follows the call graph, which has no cycles, so no two processes wait for each
+    other. A kernel already compiled here takes no lock."""
+    from numba.core import sigutils
+    from numba.core.compiler_lock import global_compiler_lock
+
+    compile_here = dispatcher.compile
+    name = f"kernel-{dispatcher.py_func.__module__}.{dispatcher.py_func.__qualname__}"
+
+    def compile(sig):
+        args, _ = sigutils.normalize_signature(sig)
+        if tuple(args) in dispatcher.overloads or name in _kernel_locks_held:
+            return compile_here(sig)
+        with global_compiler_lock, _part_lock(name):
+            _kernel_locks_held.add(name)
+            try:
+                return compile_here(sig)  # numba loads it from the cache if another process wrote it
+            finally:
+                _kernel_locks_held.discard(name)
+
+    dispatcher.compile = compile
+
+
+_kernel_locks_held: set = set()  # kernel locks this process holds (a recursive compile takes none)
 
 
 # ---------------------------------------------------------------- stale cached kernels

@@ -188,3 +188,48 @@ def test_the_cache_dir_chosen_in_a_test_does_not_outlive_it(monkeypatch, tmp_pat
         _jit._choose_cache_dir()
         assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / "nonsmooth-rod" / "numba")
     assert os.environ.get("NUMBA_CACHE_DIR") == before
+
+
+RACING_KERNEL = '''
+import os, sys, time
+from nonsmooth_rod._jit import jit, load_numba
+
+load_numba()  # its kernels are made after numba loaded: the path a late-imported module takes
+
+
+@jit
+def racer(a):
+    total = 0.0
+    for i in range(a.shape[0]):
+        for j in range(a.shape[0]):
+            total += a[i] * a[j] if i < j else a[i] - a[j]
+    return total
+
+
+if __name__ == "__main__":
+    import numpy as np
+
+    folder, me = sys.argv[1], sys.argv[2]
+    open(os.path.join(folder, "ready-" + me), "w").close()
+    while not all(os.path.exists(os.path.join(folder, f"ready-{i}")) for i in "01"):
+        time.sleep(0.001)  # both processes call at the same moment
+    racer(np.ones(3))
+    (sig,) = racer.signatures
+    print(racer.stats.cache_hits.get(sig, 0), racer.stats.cache_misses.get(sig, 0))
+'''
+
+
+def test_two_processes_compiling_one_kernel_at_once_compile_it_once(tmp_path):
+    """The second waits for the first's compile (a lock per kernel) and loads it from the cache."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("numba")
+    (tmp_path / "racing_kernel.py").write_text(RACING_KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")])))
+    env.pop("NONSMOOTH_ROD_NO_JIT", None)
+    racers = [subprocess.Popen([sys.executable, str(tmp_path / "racing_kernel.py"), str(tmp_path), str(i)],
+                               env=env, stdout=subprocess.PIPE, text=True) for i in range(2)]
+    counts = sorted(tuple(int(x) for x in r.communicate(timeout=300)[0].split()) for r in racers)
+    assert counts == [(0, 1), (1, 0)]  # one compiled (a miss), the other found it (a hit)
