@@ -53,7 +53,7 @@ def _no_compiled_loop_is_true(request, monkeypatch):
         return
     from nonsmooth_rod import _jit
 
-    def refuse(part, what, **_):
+    def refuse(part, what, prepare=None):
         pytest.fail(f"{request.node.nodeid} is marked no_compiled_loop but runs {what}: remove its mark")
 
     monkeypatch.setattr(_jit, "compiling", refuse)

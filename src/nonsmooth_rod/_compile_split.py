@@ -172,18 +172,6 @@ def compile_callees(log: Path | None = None, module: str = SHARES_MODULE) -> boo
     return True
 
 
-def help_compile(module: str = SHARES_MODULE) -> None:
-    """While another process compiles the loop and this one would only wait for it (a test
-    worker, a second run on a fresh install): compile the loop's callees here too, the helper's
-    share first. Each kernel compiles under its own lock (_jit._compile_once_across_processes),
-    so what the other process is compiling is waited for and loaded, never compiled twice."""
-    if usable_cores() < 2:
-        return
-    split = shares(module)
-    for share in split[1:] + split[:1] if split else ():
-        compile_share(share)
-
-
 def main(argv=None) -> int:
     """The helper: `python -m nonsmooth_rod._compile_split INDEX [MODULE]` compiles share INDEX
     (of MODULE's SHARES, the shipped ones by default)."""

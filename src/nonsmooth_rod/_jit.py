@@ -531,11 +531,10 @@ class compiling:
     says once what is compiled and how long it takes here, waits for any other process compiling it,
     runs `prepare(log)` (the loop's callees compiled on two cores first: _compile_split; `log`, a
     file beside the marker for a helper's output), and afterwards marks the part compiled with the
-    time it took. While another process holds the part, `help_while_waiting()` runs first (the
-    loop's callees compiled here too, each under its own kernel lock: _compile_split.help_compile)."""
+    time it took."""
 
-    def __init__(self, part: str, what: str, prepare=None, help_while_waiting=None):
-        self.part, self.what, self.prepare, self.help_while_waiting = part, what, prepare, help_while_waiting
+    def __init__(self, part: str, what: str, prepare=None):
+        self.part, self.what, self.prepare = part, what, prepare
 
     def __enter__(self):
         self.cold = ENABLED and not engine_is_warm(self.part)
@@ -543,12 +542,7 @@ class compiling:
             return self
         import time
 
-        self._lock = _part_lock(self.part, blocking=False).__enter__()
-        if not self._lock.acquired:  # another process compiles it: help (its parts), then wait
-            self._lock.__exit__(None, None, None)
-            if self.help_while_waiting is not None:
-                self.help_while_waiting()
-            self._lock = _part_lock(self.part).__enter__()
+        self._lock = _part_lock(self.part).__enter__()
         if engine_is_warm(self.part):  # another process compiled it while we waited
             self.cold = False
             return self

@@ -116,24 +116,3 @@ def test_free_cores_sees_a_busy_core():
     finally:
         spinner.kill()
         spinner.wait()
-
-
-def test_a_process_waiting_for_another_compile_helps_first_then_waits(monkeypatch, tmp_path):
-    """While another process holds the part's lock, help_while_waiting runs (once), and the part is
-    entered only after that process let go; a free part does not call it."""
-    monkeypatch.setattr(_jit, "_marker", lambda part="engine": tmp_path / f"{part}.compiled")
-    monkeypatch.setattr(_jit, "_warm", set())
-    monkeypatch.setattr(_jit, "_noticed", set())
-    holder = subprocess.Popen([sys.executable, "-c", (
-        "import fcntl, sys, time\n"
-        f"f = open({str(tmp_path / 'busy.lock')!r}, 'a'); fcntl.flock(f, fcntl.LOCK_EX)\n"
-        "print('held', flush=True); time.sleep(1.5)")], stdout=subprocess.PIPE, text=True)
-    assert holder.stdout.readline().strip() == "held"
-    held_at, helped = time.monotonic(), []
-    with _jit.compiling("busy", "a busy part", help_while_waiting=lambda: helped.append(time.monotonic() - held_at)):
-        entered = time.monotonic() - held_at
-    holder.wait()
-    assert len(helped) == 1 and helped[0] < 1.0 <= entered  # helped while it held the lock (1.5 s), entered after
-    with _jit.compiling("free", "a free part", help_while_waiting=lambda: helped.append("free")):
-        pass
-    assert len(helped) == 1

@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .. import _jit
-from .._compile_split import compile_callees, help_compile
+from .._compile_split import compile_callees
 from ..model.motion import N_NOW_COLUMNS, evaluate_python_motions
 from ..model.joints import REACTION_NAMES, ROWS_PER_JOINT, pack_joints
 from ..model.packing import C_MU_S, C_SURFACE_VELOCITY, pack_scene
@@ -286,9 +286,7 @@ class Engine:
         if not self.compiled:
             return contextlib.nullcontext()
         # the loop's callees compiled on two cores before it (_compile_split)
-        loop = self.part == LOOP_PART
-        return _jit.compiling(self.part, self.what, prepare=compile_callees if loop else None,
-                              help_while_waiting=help_compile if loop else None)
+        return _jit.compiling(self.part, self.what, prepare=compile_callees if self.part == LOOP_PART else None)
 
 
 class MoreauJean:
