@@ -686,16 +686,25 @@ def _simulation(w, data, contact_names) -> tuple[str, float, dict, list, float |
 def _check_other_methods(w, sim: dict, method: str) -> None:
     """The values of the other methods' tables too: a file whose [simulation.event-driven] holds
     rtol = -1 is wrong whichever method runs it now (`--set simulation.method=…` switches later)."""
-    flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop", "save_every") and k not in METHODS}
+    flat = _flat_options(sim)
     for name in METHODS:
         if name == method or not isinstance(sim.get(name), dict):
             continue
         allowed = _allowed_options(name)
+        _refuse_non_finite(w, f"simulation.{name}", sim[name])
         table = {**{k: v for k, v in flat.items() if k in allowed}, **sim[name]}
-        for key, value in sim[name].items():
-            if isinstance(value, float) and not math.isfinite(value):
-                raise w.error(f"simulation.{name}.{key}", f"must be finite, got {quoted(value)}")
         _check_options(w, _options_class(name), table, [], where=f"simulation.{name}")
+
+
+def _flat_options(sim: dict) -> dict:
+    """The method options given directly in [simulation] (not in a method's own table)."""
+    return {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop", "save_every") and k not in METHODS}
+
+
+def _refuse_non_finite(w, prefix: str, table: dict) -> None:
+    for key, value in table.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise w.error(f"{prefix}.{key}", f"must be finite, got {quoted(value)}")
 
 
 def _stop(w, sim: dict, contact_names) -> list:
@@ -718,18 +727,17 @@ def _method_options(w, sim: dict, method: str) -> dict:
     """Options of the chosen method: [simulation.<method>] over the flat keys of [simulation].
     The other methods' tables are checked too (_check_other_methods), so that
     `--set simulation.method=event-driven` switches to options the file already holds."""
-    flat = {k: v for k, v in sim.items() if k not in ("method", "t_end", "stop", "save_every") and k not in METHODS}
+    flat = _flat_options(sim)
     _check_keys(w, flat, _allowed_options(method) + list(METHODS), "simulation")
     for name in METHODS:
         if name in sim:
             _check_keys(w, sim[name], _allowed_options(name), f"simulation.{name}")
     own = sim.get(method, {})
-    for prefix, table in (("simulation", flat), (f"simulation.{method}", own)):
-        for key, value in table.items():
-            if isinstance(value, float) and not math.isfinite(value):
-                raise w.error(f"{prefix}.{key}", f"must be finite, got {quoted(value)}")
-            if prefix != "simulation" and key in flat:
-                raise w.error(f"simulation.{key}", f"given twice: also as {prefix}.{key}; keep one")
+    _refuse_non_finite(w, "simulation", flat)
+    _refuse_non_finite(w, f"simulation.{method}", own)
+    for key in own:
+        if key in flat:
+            raise w.error(f"simulation.{key}", f"given twice: also as simulation.{method}.{key}; keep one")
     return {**flat, **own}
 
 
