@@ -69,8 +69,10 @@ def main(argv=None) -> int:
         seconds = sum(warm_up_python_step(solver) for solver in solvers)
         print(f"compiled the step kernels around {', '.join(solvers)} in {seconds:.1f} s", flush=True)
         return 0
-    if (os.cpu_count() or 1) < 2:
-        # one core: the user's interpreted run goes first. With two or more the run and the compile
+    from ._compile_split import usable_cores
+
+    if usable_cores() < 2:
+        # one core (this process's affinity, as the split counts them): the user's interpreted run goes first. With two or more the run and the compile
         # each have a core, and a niced compile would only finish later — every run after waits for
         # it (on a fresh install the test suite's two workers sat idle behind a niced compile)
         try:
