@@ -38,6 +38,7 @@ MAX_CHUNK = 1 << 16
 # Work arrays of moreau_jean_loop that carry a contact's memory from one step to the next.
 WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
 RECORDS = ("p_normal", "p_tangent", "slip", "states")  # out[2] … out[5]
+FEW_CHANGES = 16  # state changes in a window up to which their rows are found in Python
 
 
 @dataclass
@@ -117,6 +118,16 @@ class Grid:
         self.n_steps: int = self.n_full + (1 if self.h_last else 0)
         self.last: int = self.first + self.n_steps
 
+    def times_into(self, lo: int, t: np.ndarray) -> None:
+        """`time` of the consecutive steps lo, lo + 1, … written into `t` (its values bit for bit:
+        the same product and sum a step; the run's last step t_end exactly)."""
+        n = t.shape[0]
+        if n:
+            np.multiply(np.arange(lo, lo + n, dtype=float), self.h, out=t)
+            t += self.origin
+            if lo + n - 1 == self.last:
+                t[-1] = self.t_end
+
     def time(self, k: np.ndarray | int):
         """Times of global step indices (the last one: t_end exactly)."""
         if isinstance(k, (int, np.integer)):
@@ -140,6 +151,7 @@ class Window:
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
         self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows, columns) if out is None else out
         self.rows, self.k_base, self.r = rows, 0, 0
+        self._columns = None  # (the column array, columns given, columns(), owners()) last found
         self.slip_default = np.full(n_contacts, -0.0) if slip_default is None else slip_default
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
@@ -188,19 +200,26 @@ class Window:
 
     def columns(self):
         """(contacts, columns, whether every contact's column is its index): the contacts that have
-        a column of the records, in order, and their columns."""
+        a column of the records, in order, and their columns. Kept while no column is given: a
+        column is never taken back, so the count of columns given (column[n]) names the mapping."""
         column = self.out[loop.O_COLUMN]
         n = column.shape[0] - 1
+        given = int(column[n])
+        kept = self._columns
+        if kept is not None and kept[0] is column and kept[1] == given:
+            return kept[2]
         contacts = np.flatnonzero(column[:n])
         cols = column[contacts] - 1
-        return contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
+        found = contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
+        owner = np.empty(contacts.size, dtype=np.int64)
+        owner[cols] = contacts
+        self._columns = (column, given, found, owner)
+        return found
 
     def owners(self) -> np.ndarray:
         """The contact of each column given, in column order (the order they were given in)."""
-        contacts, cols, _ = self.columns()
-        owner = np.empty(contacts.size, dtype=np.int64)
-        owner[cols] = contacts
-        return owner
+        self.columns()
+        return self._columns[3]
 
     def full(self, which: int, rows):
         """Record `which` (2 … 5: p_normal, p_tangent, slip, states) at `rows` (an index, a slice,
@@ -327,17 +346,19 @@ class Collector:
     def _contiguous_samples(self, window: Window, r0: int, ks: np.ndarray) -> None:
         """_samples of consecutive steps after a window's first row (every step kept): slices,
         not gathers — the same values."""
-        out, n = window.out, ks.size
+        out, n, k0 = window.out, ks.size, int(ks[0])
         if r0 == 0:  # the run's first state: no step leads to it
             first = self.n
-            self.t[first], self.q[first], self.v[first] = self.grid.time(ks[:1])[0], out[0][0], out[1][0]
+            self.t[first], self.q[first], self.v[first] = self.grid.time(k0), out[0][0], out[1][0]
             self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, window.full(5, 0)
             self.joint_force[first] = 0.0
-            self.n, ks, r0, n = first + 1, ks[1:], 1, n - 1
+            self.n, ks, r0, n, k0 = first + 1, ks[1:], 1, n - 1, k0 + 1
         rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(self.n, self.n + n)
         h = self.grid.h if not (self.grid.h_last or self.resume is not None) else self.step_size(ks)[:, None]
-        self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
-        np.divide(out[1][rows] - out[1][before], h, out=self.a[m])
+        self.grid.times_into(k0, self.t[m])
+        self.q[m], self.v[m] = out[0][rows], out[1][rows]
+        np.subtract(out[1][rows], out[1][before], out=self.a[m])
+        np.divide(self.a[m], h, out=self.a[m])
         np.divide(window.full(2, before), h, out=self.N[m])
         np.divide(window.full(3, before), h, out=self.T[m])
         np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
@@ -364,25 +385,29 @@ class Collector:
             for i in range(n):
                 self.runs[i].append((k0, int(start[i])))
             changed[0] = False
-        rows_changed = np.flatnonzero(changed.any(axis=1))
+        rows_changed = np.flatnonzero(changed.any(axis=1) if codes.shape[1] > 1 else changed[:, 0]).tolist()
         for m in rows_changed:  # few: a contact's state changes at its phase boundaries
             for c in np.flatnonzero(changed[m]):
-                self.runs[owner[c]].append((k0 + int(m), int(codes[m, c])))
+                self.runs[owner[c]].append((k0 + m, int(codes[m, c])))
         if first and n:
-            rows_changed = np.r_[0, rows_changed]
-        if rows_changed.size:
-            self._keep_rows(window, k0 + rows_changed, k_to, owner)
+            rows_changed.insert(0, 0)
+        if rows_changed:
+            self._keep_rows(window, [k0 + m for m in rows_changed], k_to, owner)
         self._codes_before = before.copy()
         self._codes_before[owner] = codes[-1]
 
-    def _keep_rows(self, window: Window, steps: np.ndarray, k_to: int, owner) -> None:
+    def _keep_rows(self, window: Window, steps: list, k_to: int, owner) -> None:
         """The rows of steps k − HISTORY … k for each state change at step k, as arrays (a
         contact that chatters changes every step: its rows cost what the per-step records did);
         the records of the columns given (`owner`: their contacts)."""
-        out = window.out
-        need = np.unique((steps[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
-        need = need[(need >= window.k_base) & (need <= k_to)]
-        r = need - window.k_base
+        out, lo = window.out, window.k_base
+        if len(steps) <= FEW_CHANGES:  # (a set of a few rows: cheaper than numpy's unique)
+            need = np.array(sorted({j for k in steps for j in range(max(k - HISTORY, lo), min(k, k_to) + 1)}),
+                            dtype=np.int64)
+        else:
+            need = np.unique((np.array(steps)[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
+            need = need[(need >= lo) & (need <= k_to)]
+        r = need - lo
         rec, given = np.minimum(r, out[2].shape[0] - 1), owner.size
         self._blocks.append((need, out[0][r], out[1][r], out[2][rec, :given], out[3][rec, :given],
                              out[5][rec, :given], need < k_to, owner))
