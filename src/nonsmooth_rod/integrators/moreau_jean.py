@@ -586,6 +586,7 @@ class MoreauJean:
         min_phase = self.options.min_phase
 
         def locate(result):  # on first use of result.phases or result.events
+            collector.settle_rows()
             phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop)
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
@@ -606,8 +607,11 @@ class MoreauJean:
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
         if status == "failed":
             result.end_state = None
-        else:  # built on first read (run() settles it before its arrays are reused)
-            result.build_end_state(lambda: window.resume_state(grid, work, last_h, on_grid))
+        else:  # built on first read (run() settles it before its arrays are reused), the rows with it
+            def end_state():
+                collector.settle_rows()
+                return window.resume_state(grid, work, last_h, on_grid)
+            result.build_end_state(end_state)
         return result
 
 

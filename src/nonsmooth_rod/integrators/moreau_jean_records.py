@@ -305,6 +305,7 @@ class Collector:
         self._index = None
         self.impact_rows: list[tuple] = []  # (step, contact, t, q_k, v_k, v_k+1, p_n, p_t)
         self._codes_before = None
+        self._pending_rows = None  # (window, k_from, k_to) of the last take, until settle_rows
 
     def step_size(self, k):
         """Size of the steps ending at global steps k (the shortened last one, a resumed run's first)."""
@@ -324,8 +325,21 @@ class Collector:
         if final and (ks.size == 0 or ks[-1] != k_to):
             ks = np.r_[ks, k_to]
         self._samples(window, ks)
-        self._runs_and_rows(window, k_from, k_to)
+        if final:  # read only to locate phases: taken on first need (`settle_rows`)
+            self._pending_rows = (window, k_from, k_to)
+        else:
+            self._runs_and_rows(window, k_from, k_to)
         self._impacts(window)
+
+    def settle_rows(self) -> None:
+        """The state runs and boundary rows of the run's last window, taken on first need: when
+        the phases are located, or before the window's arrays go to another run (its result's end
+        state is built then: moreau_jean._result). A short run's result whose phases nobody
+        reads never takes them."""
+        pending = self._pending_rows
+        if pending is not None:
+            self._pending_rows = None
+            self._runs_and_rows(*pending)
 
     def _samples(self, window: Window, ks: np.ndarray) -> None:
         out, rows = window.out, ks - window.k_base
