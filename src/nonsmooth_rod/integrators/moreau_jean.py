@@ -39,6 +39,7 @@ from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import accumulation
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
+from .direct_entry import DirectEntry
 from .carved import carve_zeros
 from .joint_step import work_size
 from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
@@ -249,6 +250,7 @@ _LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
 
 
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
+_DIRECT = DirectEntry()  # run_steps without numba's overload search for the model, work, records it knows
 
 
 class Engine:
@@ -445,7 +447,7 @@ class MoreauJean:
             while True:
                 out = window.out
                 if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
-                    status = kernels.run_steps(r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
+                    status = _DIRECT.run_steps(kernels, r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
                 else:
                     status = self._run_stepwise(kernels, scene, r, r0 + n, params, iparams, model, work, out)
                 if status != loop.RUN_RECORDS_SHORT:
