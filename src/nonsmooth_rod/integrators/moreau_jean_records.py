@@ -321,10 +321,13 @@ class Collector:
         """Steps k_from … k_to − 1 are done (states k_from … k_to in the window); `final`: the run
         ends at k_to."""
         lo = k_from + 1 if self.n else k_from
-        ks = kept_steps(self.grid, lo, k_to, self.save_every)
-        if final and (ks.size == 0 or ks[-1] != k_to):
-            ks = np.r_[ks, k_to]
-        self._samples(window, ks)
+        if self.save_every is None and k_to >= lo:  # every step kept: lo … k_to
+            self._contiguous_samples(window, lo - window.k_base, lo, k_to + 1 - lo)
+        else:
+            ks = kept_steps(self.grid, lo, k_to, self.save_every)
+            if final and (ks.size == 0 or ks[-1] != k_to):
+                ks = np.r_[ks, k_to]
+            self._samples(window, ks)
         if final:  # read only to locate phases: taken on first need (`settle_rows`)
             self._pending_rows = (window, k_from, k_to)
         else:
@@ -344,7 +347,7 @@ class Collector:
     def _samples(self, window: Window, ks: np.ndarray) -> None:
         out, rows = window.out, ks - window.k_base
         if ks.size and ks[-1] - ks[0] + 1 == ks.size:
-            return self._contiguous_samples(window, int(rows[0]), ks)
+            return self._contiguous_samples(window, int(rows[0]), int(ks[0]), ks.size)
         m = slice(self.n, self.n + ks.size)
         self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
         h = self.step_size(ks)[:, None]
@@ -357,27 +360,27 @@ class Collector:
         self.codes[m] = window.full(5, before)  # the first sample of a fresh run: the mode of its first step
         self.n += ks.size
 
-    def _contiguous_samples(self, window: Window, r0: int, ks: np.ndarray) -> None:
-        """_samples of consecutive steps after a window's first row (every step kept): slices,
-        not gathers — the same values."""
-        out, n, k0 = window.out, ks.size, int(ks[0])
-        if r0 == 0:  # the run's first state: no step leads to it
-            first = self.n
-            self.t[first], self.q[first], self.v[first] = self.grid.time(k0), out[0][0], out[1][0]
-            self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, window.full(5, 0)
-            self.joint_force[first] = 0.0
-            self.n, ks, r0, n, k0 = first + 1, ks[1:], 1, n - 1, k0 + 1
-        rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(self.n, self.n + n)
-        h = self.grid.h if not (self.grid.h_last or self.resume is not None) else self.step_size(ks)[:, None]
-        self.grid.times_into(k0, self.t[m])
-        self.q[m], self.v[m] = out[0][rows], out[1][rows]
-        np.subtract(out[1][rows], out[1][before], out=self.a[m])
-        np.divide(self.a[m], h, out=self.a[m])
+    def _contiguous_samples(self, window: Window, r0: int, k0: int, n: int) -> None:
+        """_samples of the n consecutive steps from k0, at rows from r0: slices, not gathers — the
+        same values."""
+        out, m0 = window.out, self.n
+        self.grid.times_into(k0, self.t[m0: m0 + n])
+        self.q[m0: m0 + n], self.v[m0: m0 + n] = out[0][r0: r0 + n], out[1][r0: r0 + n]
+        if r0 == 0 and n:  # the run's first state: no step leads to it
+            self.a[m0], self.N[m0], self.T[m0], self.codes[m0] = np.nan, 0.0, 0.0, window.full(5, 0)
+            self.joint_force[m0] = 0.0
+            m0, r0, k0, n = m0 + 1, 1, k0 + 1, n - 1
+        rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(m0, m0 + n)
+        grid = self.grid
+        h = grid.h if not (grid.h_last or self.resume is not None) else self.step_size(np.arange(k0, k0 + n))[:, None]
+        a = self.a[m]
+        np.subtract(out[1][rows], out[1][before], out=a)
+        np.divide(a, h, out=a)
         np.divide(window.full(2, before), h, out=self.N[m])
         np.divide(window.full(3, before), h, out=self.T[m])
         np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
         self.codes[m] = window.full(5, before)
-        self.n += n
+        self.n = m0 + n
 
     def _runs_and_rows(self, window: Window, k_from: int, k_to: int) -> None:
         out = window.out
