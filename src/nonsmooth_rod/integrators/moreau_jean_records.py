@@ -39,6 +39,7 @@ MAX_CHUNK = 1 << 16
 WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
 RECORDS = ("p_normal", "p_tangent", "slip", "states")  # out[2] … out[5]
 FEW_CHANGES = 16  # state changes in a window up to which their rows are found in Python
+FEW_CONTACTS = 64  # contacts up to which a window's columns are checked in Python first
 
 
 @dataclass
@@ -208,11 +209,15 @@ class Window:
         kept = self._columns
         if kept is not None and kept[0] is column and kept[1] == given:
             return kept[2]
-        contacts = np.flatnonzero(column[:n])
-        cols = column[contacts] - 1
-        found = contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
-        owner = np.empty(contacts.size, dtype=np.int64)
-        owner[cols] = contacts
+        if given == n and n <= FEW_CONTACTS and column[:n].tolist() == list(range(1, n + 1)):
+            contacts = np.arange(n)  # every contact's column its index (declared contacts): no search
+            found, owner = (contacts, contacts, True), contacts
+        else:
+            contacts = np.flatnonzero(column[:n])
+            cols = column[contacts] - 1
+            found = contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
+            owner = np.empty(contacts.size, dtype=np.int64)
+            owner[cols] = contacts
         self._columns = (column, given, found, owner)
         return found
 
