@@ -253,6 +253,7 @@ LOOP_PART = "moreau-jean"
 _LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
 
 
+_NOTHING = contextlib.nullcontext()  # (reusable: it holds nothing)
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
 _DIRECT = DirectEntry()  # run_steps without numba's overload search for the model, work, records it knows
 
@@ -289,8 +290,8 @@ class Engine:
 
     def compiling(self):
         """The compile notice and lock around a call of the compiled kernels (nothing when warm)."""
-        if not self.compiled:
-            return contextlib.nullcontext()
+        if not self.compiled or _jit.engine_is_warm(self.part):  # (a set lookup once known warm)
+            return _NOTHING
         # the loop's callees compiled on two cores before it (_compile_split)
         return _jit.compiling(self.part, self.what, prepare=compile_callees if self.part == LOOP_PART else None)
 

@@ -368,12 +368,13 @@ class Collector:
     def _contiguous_samples(self, window: Window, r0: int, k0: int, n: int) -> None:
         """_samples of the n consecutive steps from k0, at rows from r0: slices, not gathers — the
         same values."""
-        out, m0 = window.out, self.n
+        out, m0, joints = window.out, self.n, self.joint_force.shape[1]
         self.grid.times_into(k0, self.t[m0: m0 + n])
         self.q[m0: m0 + n], self.v[m0: m0 + n] = out[0][r0: r0 + n], out[1][r0: r0 + n]
         if r0 == 0 and n:  # the run's first state: no step leads to it
             self.a[m0], self.N[m0], self.T[m0], self.codes[m0] = np.nan, 0.0, 0.0, window.full(5, 0)
-            self.joint_force[m0] = 0.0
+            if joints:
+                self.joint_force[m0] = 0.0
             m0, r0, k0, n = m0 + 1, 1, k0 + 1, n - 1
         rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(m0, m0 + n)
         grid = self.grid
@@ -383,7 +384,8 @@ class Collector:
         np.divide(a, h, out=a)
         np.divide(window.full(2, before), h, out=self.N[m])
         np.divide(window.full(3, before), h, out=self.T[m])
-        np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
+        if joints:
+            np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
         self.codes[m] = window.full(5, before)
         self.n = m0 + n
 
