@@ -199,7 +199,12 @@ def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int, slip
     """The run's window: with the records an earlier run of the scene lent (zeroed), or new, with
     a column of records for the contacts that are candidates (moreau_jean_loop.new_records)."""
     columns = max(MIN_RECORD_COLUMNS, RECORD_COLUMNS_PER_BODY * (n_dof // 3))
-    return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk), columns, slip_default)
+    lent = plan.borrow(HISTORY + chunk)
+    window = Window(n_dof, n_contacts, chunk, joint_rows, lent, columns, slip_default)
+    # a window small enough to lend leaves its last rows to be taken on first need (Collector.settle_rows:
+    # its result then holds it); a larger one has them taken in the run, as its result's end state
+    window.defer_rows = lent is not None or sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES
+    return window
 
 
 def _same_float(a: float, b: float) -> bool:

@@ -153,6 +153,7 @@ class Window:
         self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows, columns) if out is None else out
         self.rows, self.k_base, self.r = rows, 0, 0
         self._columns = None  # (the column array, columns given, columns(), owners()) last found
+        self.defer_rows = False  # the last take leaves its state runs and rows to Collector.settle_rows
         self.slip_default = np.full(n_contacts, -0.0) if slip_default is None else slip_default
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
@@ -333,7 +334,7 @@ class Collector:
             if final and (ks.size == 0 or ks[-1] != k_to):
                 ks = np.r_[ks, k_to]
             self._samples(window, ks)
-        if final:  # read only to locate phases: taken on first need (`settle_rows`)
+        if final and window.defer_rows:  # read only to locate phases: taken on first need (`settle_rows`)
             self._pending_rows = (window, k_from, k_to)
         else:
             self._runs_and_rows(window, k_from, k_to)
