@@ -410,7 +410,7 @@ class Collector:
             for i in range(n):
                 self.runs[i].append((k0, int(start[i])))
             changed[0] = False
-        rows_changed = np.flatnonzero(changed.any(axis=1) if codes.shape[1] > 1 else changed[:, 0]).tolist()
+        rows_changed = np.flatnonzero(changed[:, 0] if codes.shape[1] == 1 else changed.any(axis=1)).tolist()
         for m in rows_changed:  # few: a contact's state changes at its phase boundaries
             for c in np.flatnonzero(changed[m]):
                 self.runs[owner[c]].append((k0 + m, int(codes[m, c])))
