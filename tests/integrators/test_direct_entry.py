@@ -77,7 +77,7 @@ def test_large_arguments_are_not_held():
     call(direct, kernels, model, work, out)
     call(direct, kernels, model, work, out)
     assert (dispatcher.calls, dispatcher.entry_calls) == (2, 0)
-    assert not direct._known
+    assert not direct._state[2]
 
 
 @pytest.mark.skipif(not _jit.ENABLED, reason="the compiled loop (numba) is off")
@@ -85,14 +85,14 @@ def test_a_run_through_the_entry_point_is_the_run_through_the_dispatcher(monkeyp
     scene = ball_scene()
     runs = [run(scene, repeat_rest=False) for _ in range(4)]  # lent sets come back from the third
     counted = {"entry": 0}
-    entry = moreau_jean._DIRECT.entry
+    dispatcher, entry, known = moreau_jean._DIRECT._state
     assert entry is not None  # the compiled loop has one overload
 
     def counting(*args):
         counted["entry"] += 1
         return entry(*args)
 
-    monkeypatch.setattr(moreau_jean._DIRECT, "entry", counting)
+    monkeypatch.setattr(moreau_jean._DIRECT, "_state", (dispatcher, counting, known))
     again = run(scene, repeat_rest=False)
     assert counted["entry"] == 1
     monkeypatch.setattr(moreau_jean, "_DIRECT", DirectEntry())  # through the dispatcher

@@ -25,17 +25,19 @@ class DirectEntry:
     """`run_steps(kernels, ...)`: kernels.run_steps(...), through the one compiled overload's
     entry point for arguments an earlier call passed to that overload."""
 
-    __slots__ = ("dispatcher", "entry", "_known")
+    __slots__ = ("_state",)
 
     def __init__(self):
-        self.dispatcher = self.entry = None
-        self._known: dict = {}  # id → the object (held: its id cannot name another object)
+        # (dispatcher, its overload's entry point, {id: object known to have its types}), replaced
+        # whole, never changed in place: a thread reads one consistent state
+        self._state = (None, None, {})
 
     def run_steps(self, kernels, k_start, k_end, params, iparams, model, work, out, extra):
-        known, dispatcher = self._known, kernels.run_steps
-        if (dispatcher is self.dispatcher and known.get(id(model)) is model and known.get(id(work)) is work
+        dispatcher = kernels.run_steps
+        known_dispatcher, entry, known = self._state
+        if (dispatcher is known_dispatcher and known.get(id(model)) is model and known.get(id(work)) is work
                 and known.get(id(out)) is out):
-            return self.entry(k_start, k_end, params, iparams, model, work, out, extra)
+            return entry(k_start, k_end, params, iparams, model, work, out, extra)
         status = dispatcher(k_start, k_end, params, iparams, model, work, out, extra)
         self._learn(dispatcher, model, work, out)
         return status
@@ -47,19 +49,17 @@ class DirectEntry:
         if overloads is not None and len(overloads) == 1:
             entry = getattr(next(iter(overloads.values())), "entry_point", None)
         if entry is None or not callable(entry):
-            self.dispatcher = self.entry = None
-            self._known.clear()
+            self._state = (None, None, {})
             return
-        if entry is not self.entry or dispatcher is not self.dispatcher:
-            self._known.clear()
-            self.dispatcher, self.entry = dispatcher, entry
         # their largest arrays: the contacts' table and memory, the records' states and impulses
         if model[2].nbytes + work[2].nbytes + out[0].nbytes + out[2].nbytes > MAX_KNOWN_BYTES:
             return  # a large scene or a long run: the search is a small part of its call
-        if len(self._known) + 3 > MAX_KNOWN:
-            self._known.clear()
+        known_dispatcher, known_entry, known = self._state
+        same = known_dispatcher is dispatcher and known_entry is entry and len(known) + 3 <= MAX_KNOWN
+        known = dict(known) if same else {}
         for obj in (model, work, out):
-            self._known[id(obj)] = obj
+            known[id(obj)] = obj
+        self._state = (dispatcher, entry, known)
 
 
 __all__ = ["DirectEntry"]
