@@ -51,6 +51,7 @@ def test_bench_scenes_fixed_cost_prints_every_one_body_scene(capsys):
     rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
     assert [row[1] for row in rows] == list(module.ONE_CONTACT) + ["BlockOnIncline"]
     for row in rows:
-        whole, loop, outside, ratio = map(float, row[-4:])
+        whole, loop, outside, ratio, one_step = map(float, row[-5:])
         assert whole >= loop > 0 and ratio >= 1.0  # the call contains its loop
         assert abs(whole - loop - outside) <= 0.15  # the columns' rounding
+        assert 0 < one_step

@@ -98,6 +98,24 @@ def test_an_end_state_first_read_after_later_runs_is_its_own_runs():
     assert same_bits(later[0].end_state.v, nr.simulate(ball_scene(), Q0, -V0, T_END, h=H).end_state.v)
 
 
+@pytest.mark.parametrize("end_state_first", [False, True])
+def test_phases_first_read_after_later_runs_are_its_own_runs(end_state_first):
+    """A short run's last rows (the state runs and boundary rows its phases are located from) are
+    taken on first need from the records its plan lends to the next runs (Collector.settle_rows):
+    its phases and events, read only after three more runs of the scene with other numbers
+    (before or after its end state), are those of the same run of a scene packed afresh."""
+    scene = ball_scene()
+    first = run(scene)
+    if end_state_first:
+        first.end_state
+    later = [nr.simulate(scene, Q0, v0, T_END, h=H) for v0 in (-V0, 2 * V0, 0.5 * V0)]
+    want = run(ball_scene())
+    assert {p.mode for p in want.phases["floor"]} >= {"open", "slip+", "stick"}
+    assert first.phases == want.phases and first.events == want.events
+    other = nr.simulate(ball_scene(), Q0, -V0, T_END, h=H)
+    assert later[0].phases == other.phases and later[0].events == other.events
+
+
 @pytest.mark.parametrize("change", ["law", "radius", "line", "contacts list", "weight in place", "forces"])
 def test_a_change_of_the_scene_between_runs_is_seen(change):
     """Each change gives the run of a scene built with it from the start, not the kept plan's."""

@@ -39,6 +39,7 @@ from ..validation import Flag, InputError, Number, Text, check_options, option
 from . import accumulation
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
+from .direct_entry import DirectEntry
 from .carved import carve_zeros
 from .joint_step import work_size
 from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
@@ -194,12 +195,21 @@ LENT_WINDOW_BYTES = 1 << 18
 RECORD_COLUMNS_PER_BODY, MIN_RECORD_COLUMNS = 8, 16
 
 
-def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int) -> Window:
+def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int, slip_default) -> Window:
     """The run's window: with the records an earlier run of the scene lent (zeroed), or new, with
     a column of records for the contacts that are candidates (moreau_jean_loop.new_records)."""
     columns = max(MIN_RECORD_COLUMNS, RECORD_COLUMNS_PER_BODY * (n_dof // 3))
-    return Window(n_dof, n_contacts, chunk, joint_rows, plan.borrow(HISTORY + chunk), columns,
-                  -plan.packed.contacts[:, C_SURFACE_VELOCITY])
+    lent = plan.borrow(HISTORY + chunk)
+    window = Window(n_dof, n_contacts, chunk, joint_rows, lent, columns, slip_default)
+    # a window small enough to lend leaves its last rows to be taken on first need (Collector.settle_rows:
+    # its result then holds it); a larger one has them taken in the run, as its result's end state
+    window.defer_rows = lent is not None or sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES
+    return window
+
+
+def _same_float(a: float, b: float) -> bool:
+    """The same float, sign of zero included (−0.0 is not 0.0: the grid's times would differ in it)."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
 
 
 def _lend_window(plan, window: Window, holder=None) -> bool:
@@ -248,7 +258,9 @@ LOOP_PART = "moreau-jean"
 _LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
 
 
+_NOTHING = contextlib.nullcontext()  # (reusable: it holds nothing)
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
+_DIRECT = DirectEntry()  # run_steps without numba's overload search for the model, work, records it knows
 
 
 class Engine:
@@ -283,8 +295,8 @@ class Engine:
 
     def compiling(self):
         """The compile notice and lock around a call of the compiled kernels (nothing when warm)."""
-        if not self.compiled:
-            return contextlib.nullcontext()
+        if not self.compiled or _jit.engine_is_warm(self.part):  # (a set lookup once known warm)
+            return _NOTHING
         # the loop's callees compiled on two cores before it (_compile_split)
         return _jit.compiling(self.part, self.what, prepare=compile_callees if self.part == LOOP_PART else None)
 
@@ -320,14 +332,14 @@ class MoreauJean:
         if opts.tol is not None:
             return self._run_with_tol(scene, q0, v0, t_end, t0, resume, save_every, stop,
                                       [c.name for c in scene.contacts])
-        grid = Grid.of(opts.h, t0, t_end, resume)
         plan = scene_plan(scene)  # packed once for the runs that repeat the scene
         packed, names = plan.packed, list(plan.names)
+        grid, params, iparams, slip_default = self._run_parameters(plan, scene, t0, t_end, resume, names)
         model, work, v0 = _run_data(plan, q0, v0, grid, resume)
-        window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints))
+        window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints),
+                         slip_default)
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
-        params, iparams = self._run_parameters(plan, scene, grid, names)
         solver_code = SOLVER_CODES.get(opts.solver)
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
         self._motions_in_python = plan.python_motions
@@ -365,16 +377,22 @@ class MoreauJean:
             return run_adaptive(self, scene, q0, v0, t_end, t0, resume, save_every, list(stop), engine,
                                 model, work, params, iparams, PROBE_STEPS, _BOUNDARY_KIND)
 
-    def _run_parameters(self, plan, scene, grid, names):
-        """_parameters, kept by the scene's plan for its next run with the same options object
-        (the driver hands the same checked options to runs with the same values) and start:
-        copies, for the loop writes into params."""
+    def _run_parameters(self, plan, scene, t0, t_end, resume, names):
+        """(grid, params, iparams, slip record of a contact out of reach) of a run: kept by the
+        scene's plan for its next run from (q0, v0) with the same options object (the driver hands
+        the same checked options to runs with the same values), start and end; the parameters
+        copied, for the loop writes into them (a grid is never changed)."""
         kept = plan.parameters
-        if kept is None or kept[0] is not self.options or kept[1] != grid.origin or \
-                math.copysign(1.0, kept[1]) != math.copysign(1.0, grid.origin):  # -0.0 is not 0.0
+        if resume is None and kept is not None and kept[0] is self.options and _same_float(kept[1], t0) \
+                and _same_float(kept[2], t_end):
+            grid, params, iparams, slip_default = kept[3:]
+        else:
+            grid = Grid.of(self.options.h, t0, t_end, resume)
             params, iparams = self._parameters(scene, grid, names, plan.varies_in_time)
-            kept = plan.parameters = (self.options, grid.origin, params, iparams)
-        return kept[2].copy(), kept[3].copy()
+            slip_default = -plan.packed.contacts[:, C_SURFACE_VELOCITY]
+            if resume is None:
+                plan.parameters = (self.options, t0, t_end, grid, params, iparams, slip_default)
+        return grid, params.copy(), iparams.copy(), slip_default
 
     def _parameters(self, scene, grid, names, varies_in_time=None):
         opts = self.options
@@ -445,7 +463,7 @@ class MoreauJean:
             while True:
                 out = window.out
                 if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
-                    status = kernels.run_steps(r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
+                    status = _DIRECT.run_steps(kernels, r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
                 else:
                     status = self._run_stepwise(kernels, scene, r, r0 + n, params, iparams, model, work, out)
                 if status != loop.RUN_RECORDS_SHORT:
@@ -586,6 +604,7 @@ class MoreauJean:
         min_phase = self.options.min_phase
 
         def locate(result):  # on first use of result.phases or result.events
+            collector.settle_rows()
             phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop)
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
@@ -606,8 +625,11 @@ class MoreauJean:
             collector.resume.last_h if k_end == grid.first and collector.resume is not None else grid.h)
         if status == "failed":
             result.end_state = None
-        else:  # built on first read (run() settles it before its arrays are reused)
-            result.build_end_state(lambda: window.resume_state(grid, work, last_h, on_grid))
+        else:  # built on first read (run() settles it before its arrays are reused), the rows with it
+            def end_state():
+                collector.settle_rows()
+                return window.resume_state(grid, work, last_h, on_grid)
+            result.build_end_state(end_state)
         return result
 
 

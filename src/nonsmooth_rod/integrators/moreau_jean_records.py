@@ -38,6 +38,8 @@ MAX_CHUNK = 1 << 16
 # Work arrays of moreau_jean_loop that carry a contact's memory from one step to the next.
 WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
 RECORDS = ("p_normal", "p_tangent", "slip", "states")  # out[2] … out[5]
+FEW_CHANGES = 16  # state changes in a window up to which their rows are found in Python
+FEW_CONTACTS = 64  # contacts up to which a window's columns are checked in Python first
 
 
 @dataclass
@@ -117,6 +119,16 @@ class Grid:
         self.n_steps: int = self.n_full + (1 if self.h_last else 0)
         self.last: int = self.first + self.n_steps
 
+    def times_into(self, lo: int, t: np.ndarray) -> None:
+        """`time` of the consecutive steps lo, lo + 1, … written into `t` (its values bit for bit:
+        the same product and sum a step; the run's last step t_end exactly)."""
+        n = t.shape[0]
+        if n:
+            np.multiply(np.arange(lo, lo + n, dtype=float), self.h, out=t)
+            t += self.origin
+            if lo + n - 1 == self.last:
+                t[-1] = self.t_end
+
     def time(self, k: np.ndarray | int):
         """Times of global step indices (the last one: t_end exactly)."""
         if isinstance(k, (int, np.integer)):
@@ -140,6 +152,8 @@ class Window:
         capacity = chunk + 4 * n_contacts  # impacts in one window: at most one per contact per step
         self.out = loop.new_records(n_dof, n_contacts, rows, capacity, joint_rows, columns) if out is None else out
         self.rows, self.k_base, self.r = rows, 0, 0
+        self._columns = None  # (the column array, columns given, columns(), owners()) last found
+        self.defer_rows = False  # the last take leaves its state runs and rows to Collector.settle_rows
         self.slip_default = np.full(n_contacts, -0.0) if slip_default is None else slip_default
 
     def seed(self, q0, v0, first: int, resume: ResumeState | None) -> None:
@@ -188,19 +202,30 @@ class Window:
 
     def columns(self):
         """(contacts, columns, whether every contact's column is its index): the contacts that have
-        a column of the records, in order, and their columns."""
+        a column of the records, in order, and their columns. Kept while no column is given: a
+        column is never taken back, so the count of columns given (column[n]) names the mapping."""
         column = self.out[loop.O_COLUMN]
         n = column.shape[0] - 1
-        contacts = np.flatnonzero(column[:n])
-        cols = column[contacts] - 1
-        return contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
+        given = int(column[n])
+        kept = self._columns
+        if kept is not None and kept[0] is column and kept[1] == given:
+            return kept[2]
+        if given == n and n <= FEW_CONTACTS and column[:n].tolist() == list(range(1, n + 1)):
+            contacts = np.arange(n)  # every contact's column its index (declared contacts): no search
+            found, owner = (contacts, contacts, True), contacts
+        else:
+            contacts = np.flatnonzero(column[:n])
+            cols = column[contacts] - 1
+            found = contacts, cols, contacts.size == n and bool(np.all(cols == contacts))
+            owner = np.empty(contacts.size, dtype=np.int64)
+            owner[cols] = contacts
+        self._columns = (column, given, found, owner)
+        return found
 
     def owners(self) -> np.ndarray:
         """The contact of each column given, in column order (the order they were given in)."""
-        contacts, cols, _ = self.columns()
-        owner = np.empty(contacts.size, dtype=np.int64)
-        owner[cols] = contacts
-        return owner
+        self.columns()
+        return self._columns[3]
 
     def full(self, which: int, rows):
         """Record `which` (2 … 5: p_normal, p_tangent, slip, states) at `rows` (an index, a slice,
@@ -286,6 +311,7 @@ class Collector:
         self._index = None
         self.impact_rows: list[tuple] = []  # (step, contact, t, q_k, v_k, v_k+1, p_n, p_t)
         self._codes_before = None
+        self._pending_rows = None  # (window, k_from, k_to) of the last take, until settle_rows
 
     def step_size(self, k):
         """Size of the steps ending at global steps k (the shortened last one, a resumed run's first)."""
@@ -301,17 +327,33 @@ class Collector:
         """Steps k_from … k_to − 1 are done (states k_from … k_to in the window); `final`: the run
         ends at k_to."""
         lo = k_from + 1 if self.n else k_from
-        ks = kept_steps(self.grid, lo, k_to, self.save_every)
-        if final and (ks.size == 0 or ks[-1] != k_to):
-            ks = np.r_[ks, k_to]
-        self._samples(window, ks)
-        self._runs_and_rows(window, k_from, k_to)
+        if self.save_every is None and k_to >= lo:  # every step kept: lo … k_to
+            self._contiguous_samples(window, lo - window.k_base, lo, k_to + 1 - lo)
+        else:
+            ks = kept_steps(self.grid, lo, k_to, self.save_every)
+            if final and (ks.size == 0 or ks[-1] != k_to):
+                ks = np.r_[ks, k_to]
+            self._samples(window, ks)
+        if final and window.defer_rows:  # read only to locate phases: taken on first need (`settle_rows`)
+            self._pending_rows = (window, k_from, k_to)
+        else:
+            self._runs_and_rows(window, k_from, k_to)
         self._impacts(window)
+
+    def settle_rows(self) -> None:
+        """The state runs and boundary rows of the run's last window, taken on first need: when
+        the phases are located, or before the window's arrays go to another run (its result's end
+        state is built then: moreau_jean._result). A short run's result whose phases nobody
+        reads never takes them."""
+        pending = self._pending_rows
+        if pending is not None:
+            self._pending_rows = None
+            self._runs_and_rows(*pending)
 
     def _samples(self, window: Window, ks: np.ndarray) -> None:
         out, rows = window.out, ks - window.k_base
         if ks.size and ks[-1] - ks[0] + 1 == ks.size:
-            return self._contiguous_samples(window, int(rows[0]), ks)
+            return self._contiguous_samples(window, int(rows[0]), int(ks[0]), ks.size)
         m = slice(self.n, self.n + ks.size)
         self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
         h = self.step_size(ks)[:, None]
@@ -324,25 +366,29 @@ class Collector:
         self.codes[m] = window.full(5, before)  # the first sample of a fresh run: the mode of its first step
         self.n += ks.size
 
-    def _contiguous_samples(self, window: Window, r0: int, ks: np.ndarray) -> None:
-        """_samples of consecutive steps after a window's first row (every step kept): slices,
-        not gathers — the same values."""
-        out, n = window.out, ks.size
-        if r0 == 0:  # the run's first state: no step leads to it
-            first = self.n
-            self.t[first], self.q[first], self.v[first] = self.grid.time(ks[:1])[0], out[0][0], out[1][0]
-            self.a[first], self.N[first], self.T[first], self.codes[first] = np.nan, 0.0, 0.0, window.full(5, 0)
-            self.joint_force[first] = 0.0
-            self.n, ks, r0, n = first + 1, ks[1:], 1, n - 1
-        rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(self.n, self.n + n)
-        h = self.grid.h if not (self.grid.h_last or self.resume is not None) else self.step_size(ks)[:, None]
-        self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
-        np.divide(out[1][rows] - out[1][before], h, out=self.a[m])
+    def _contiguous_samples(self, window: Window, r0: int, k0: int, n: int) -> None:
+        """_samples of the n consecutive steps from k0, at rows from r0: slices, not gathers — the
+        same values."""
+        out, m0, joints = window.out, self.n, self.joint_force.shape[1]
+        self.grid.times_into(k0, self.t[m0: m0 + n])
+        self.q[m0: m0 + n], self.v[m0: m0 + n] = out[0][r0: r0 + n], out[1][r0: r0 + n]
+        if r0 == 0 and n:  # the run's first state: no step leads to it
+            self.a[m0], self.N[m0], self.T[m0], self.codes[m0] = np.nan, 0.0, 0.0, window.full(5, 0)
+            if joints:
+                self.joint_force[m0] = 0.0
+            m0, r0, k0, n = m0 + 1, 1, k0 + 1, n - 1
+        rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(m0, m0 + n)
+        grid = self.grid
+        h = grid.h if not (grid.h_last or self.resume is not None) else self.step_size(np.arange(k0, k0 + n))[:, None]
+        a = self.a[m]
+        np.subtract(out[1][rows], out[1][before], out=a)
+        np.divide(a, h, out=a)
         np.divide(window.full(2, before), h, out=self.N[m])
         np.divide(window.full(3, before), h, out=self.T[m])
-        np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
+        if joints:
+            np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
         self.codes[m] = window.full(5, before)
-        self.n += n
+        self.n = m0 + n
 
     def _runs_and_rows(self, window: Window, k_from: int, k_to: int) -> None:
         out = window.out
@@ -364,25 +410,29 @@ class Collector:
             for i in range(n):
                 self.runs[i].append((k0, int(start[i])))
             changed[0] = False
-        rows_changed = np.flatnonzero(changed.any(axis=1))
+        rows_changed = np.flatnonzero(changed[:, 0] if codes.shape[1] == 1 else changed.any(axis=1)).tolist()
         for m in rows_changed:  # few: a contact's state changes at its phase boundaries
             for c in np.flatnonzero(changed[m]):
-                self.runs[owner[c]].append((k0 + int(m), int(codes[m, c])))
+                self.runs[owner[c]].append((k0 + m, int(codes[m, c])))
         if first and n:
-            rows_changed = np.r_[0, rows_changed]
-        if rows_changed.size:
-            self._keep_rows(window, k0 + rows_changed, k_to, owner)
+            rows_changed.insert(0, 0)
+        if rows_changed:
+            self._keep_rows(window, [k0 + m for m in rows_changed], k_to, owner)
         self._codes_before = before.copy()
         self._codes_before[owner] = codes[-1]
 
-    def _keep_rows(self, window: Window, steps: np.ndarray, k_to: int, owner) -> None:
+    def _keep_rows(self, window: Window, steps: list, k_to: int, owner) -> None:
         """The rows of steps k − HISTORY … k for each state change at step k, as arrays (a
         contact that chatters changes every step: its rows cost what the per-step records did);
         the records of the columns given (`owner`: their contacts)."""
-        out = window.out
-        need = np.unique((steps[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
-        need = need[(need >= window.k_base) & (need <= k_to)]
-        r = need - window.k_base
+        out, lo = window.out, window.k_base
+        if len(steps) <= FEW_CHANGES:  # (a set of a few rows: cheaper than numpy's unique)
+            need = np.array(sorted({j for k in steps for j in range(max(k - HISTORY, lo), min(k, k_to) + 1)}),
+                            dtype=np.int64)
+        else:
+            need = np.unique((np.array(steps)[:, None] - np.arange(HISTORY + 1)[None, :]).ravel())
+            need = need[(need >= lo) & (need <= k_to)]
+        r = need - lo
         rec, given = np.minimum(r, out[2].shape[0] - 1), owner.size
         self._blocks.append((need, out[0][r], out[1][r], out[2][rec, :given], out[3][rec, :given],
                              out[5][rec, :given], need < k_to, owner))

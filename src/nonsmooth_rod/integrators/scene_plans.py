@@ -62,7 +62,7 @@ class ScenePlan:
         self.model = None
         self._spares: dict = {}  # key → [(arrays, the buffers they are carved from, their result's weakref)]
         self._owners: dict = {}  # id(arrays) → (arrays, their buffers, their bytes)
-        self.parameters = None  # (options, t0, params, iparams) of the last run (moreau_jean._run_parameters)
+        self.parameters = None  # (options, t0, t_end, grid, params, iparams, slip default) of the last run (moreau_jean._run_parameters)
 
     def borrow(self, key):
         """A set of arrays lent under `key` by an earlier run, zeroed, or None (none lent, or other
