@@ -35,13 +35,14 @@ from .._jit import jit, jit_borrowing
 _inlined = _jit.jit_inline  # the small per-contact helpers, compiled into the step's functions
 from ..model.contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
                                       C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
-                                      C_MOTION,
-                                      KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
+                                      C_MOTION, KIND_FIXED_VERTEX_ON_EDGE, KIND_VERTEX_ON_EDGE,
+                                      KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity,
+                                      vertex_cone_margin)
 from ..model.forces import accumulate_forces
 from .carved import carve_zeros
 from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_BODY_B, CI_KIND,
                              contact_kinematics, drive_contacts, row_dot)
 from ..solvers.kernels import carve, carve_matrix, solver_scratch, takes_block_sparse
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
@@ -439,7 +440,10 @@ def broad_candidates(h, gamma, q, v, disks, disk_body, pair_keys, pair_contact, 
     clearance at the build less D + S, so one that cleared s/2 at the build is still out; a
     driven or moving line's contacts are always kept. A contact closed at the build is kept, and
     one closes later only as a candidate, hence kept. Each step then marks exactly what the
-    full broad phase marks (tests/integrators/test_broad_phase.py), so results are unchanged."""
+    full broad phase marks, less the vertex–edge pairs whose cone rule rejects them at every pose
+    until the next build (_out_of_cone_until_rebuilt: the kernel would give them an infinite gap
+    and zero rows, the records of a contact out of reach — finish_arrays), so results are
+    unchanged (tests/integrators/test_broad_phase.py)."""
     n, n_dof = disks.shape[0], q.shape[0]
     if kept.shape[0] == 0 or kept_pose.shape[0] == 0 or n + 4 * (n_dof // 3) > room.shape[0]:
         _mark_candidates(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate, room)
@@ -485,8 +489,10 @@ def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, wa
     """Build the kept list at pose q (broad_candidates): the listed circle pairs within each
     other's radius + s/2 + slack or closed (found as the broad phase finds pairs in reach:
     each tested, or swept), and the points on lines closed, on a driven or moving line, or
-    within s/2 of it; every other such contact's candidate set to 0 until the next build (the
-    contacts the broad phase never leaves out: 1). Records the pose, the levers and the skin."""
+    within s/2 of it, less the vertex–edge pairs the cone rule rejects until the next build
+    (_out_of_cone_until_rebuilt); every other such contact's candidate set to 0 until the next
+    build (the contacts the broad phase never leaves out: 1). Records the pose, the levers and
+    the skin."""
     n, n_dof = disks.shape[0], q.shape[0]
     pose, x, y, placed, levers = _pose_views(kept_pose, n_dof, n)
     skin = _skin_and_levers(disks, disk_body, table, index, pose, n_dof)
@@ -509,6 +515,9 @@ def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, wa
     for j in range(pair_keys.shape[0]):
         while pair_keys[j] >= (da + 1) * n:
             da += 1
+        if candidate[pair_contact[j]] and _out_of_cone_until_rebuilt(pair_contact[j], q, table, index, was_closed,
+                                                                     pose, skin):
+            candidate[pair_contact[j]] = 0
         if candidate[pair_contact[j]]:
             kept[2 + 3 * count], kept[3 + 3 * count], kept[4 + 3 * count] = pair_contact[j], da, pair_keys[j] - da * n
             count += 1
@@ -528,6 +537,34 @@ def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, wa
     for d in range(n_dof):
         pose[d] = q[d]
     pose[n_dof + n_dof // 3 + 1] = 1.0
+
+
+# Added to the bound on a kept vertex–edge pair's cone margin (_out_of_cone_until_rebuilt): the
+# round-off of a few products of unit vectors, with room to spare.
+CONE_MARGIN_SLACK = 1e-9
+
+
+@_inlined
+def _out_of_cone_until_rebuilt(i, q, table, index, was_closed, pose, skin):
+    """Whether contact i, a vertex on an edge not closed, is rejected by the kernel's cone rule at
+    every pose the kept list built at q serves (vertex_cone_margin < 0): its margin now below
+    minus the most the two bodies can turn before a rebuild — |Δθ| L ≤ BROAD_PHASE_REBUILD s for
+    a body of lever L (_past_skin), and the margin moves by at most the relative turn. Such a
+    pair (a box's corner beside the side of the box it sits on) would get an infinite gap and
+    zero rows every step: left out, it costs no kinematics and no column of the records."""
+    kind = index[i, CI_KIND]
+    if was_closed[i] or (kind != KIND_VERTEX_ON_EDGE and kind != KIND_FIXED_VERTEX_ON_EDGE):
+        return False
+    point, edge = index[i, CI_BODY_A], index[i, CI_BODY_B]
+    if kind == KIND_FIXED_VERTEX_ON_EDGE:  # (a segment's end on body a's edge)
+        point, edge = -1, index[i, CI_BODY_A]
+    n_dof = q.shape[0]
+    turn = 0.0
+    for body in (point, edge):
+        if body >= 0:
+            lever = pose[n_dof + body]
+            turn += BROAD_PHASE_REBUILD * skin / lever if lever > 0.0 else math.inf
+    return vertex_cone_margin(table[i], point, edge, q) < -turn - CONE_MARGIN_SLACK
 
 
 @jit_borrowing
@@ -912,10 +949,10 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
         p_normal[k, c] = 0.0
         p_tangent[k, c] = 0.0
         state_rec[k, c] = 0
-        if not broad or candidate[i]:
+        if (not broad or candidate[i]) and gaps[i] != math.inf:
             slip[k, c] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
-        else:  # a contact out of reach has zero rows: only the belt's surface velocity is left
-            slip[k, c] = -table[i, C_SURFACE_VELOCITY]
+        else:  # a contact out of reach, or not the touching pair, has zero rows: only the belt's
+            slip[k, c] = -table[i, C_SURFACE_VELOCITY]  # surface velocity is left (its ±0 not v's)
     for a in range(na):
         i = active[a]
         c = column[i] - 1  # (an active contact is a candidate: it has its column)
