@@ -155,7 +155,7 @@ def _kept_marks(packed, q_build, q, v, h, gamma):
     kept, kept_pose = np.zeros(n_kept, dtype=np.int64), np.zeros(n_pose)
     candidate, was_closed, room = np.ones(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.empty(11 * nc)
     args = (packed.disks, packed.disk_body, packed.pair_keys, packed.pair_contact, packed.contacts,
-            packed.contact_index, was_closed, candidate, room, kept, kept_pose)
+            packed.contact_index, was_closed, candidate, room, kept, kept_pose, np.zeros(nc + 1, dtype=np.int64))
     loop.broad_candidates(h, gamma, q_build, np.zeros(n_dof), *args)  # the build
     loop.broad_candidates(h, gamma, q, v, *args)
     return candidate, kept[0] + kept[1], not np.array_equal(kept_pose[:n_dof], q_build)  # (the pose of the build)
