@@ -58,7 +58,7 @@ def _harness():
         for _ in range(reps):
             L.broad_candidates(h, params[L.P_GAMMA], o.q[k], o.v[k], m.disks, m.disk_body, m.pair_keys,
                                m.pair_contact, m.contacts, m.contact_index, w.was_closed, w.candidate, s.floats,
-                               s.kept, s.kept_pose)
+                               s.kept, s.kept_pose, o.column)
         return 0
 
     @numba.njit
@@ -79,7 +79,8 @@ def _harness():
         for r in range(reps):
             L.finish_arrays(r % rows, params, iparams, na, p, u, states, qk, vk, m.minv, m.contacts,
                             m.contact_index, m.pair_keys, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht,
-                            w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o)
+                            w.active, w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o,
+                            s.kept)
         return 0
 
     @numba.njit

@@ -70,7 +70,7 @@ SHARES = (
         ('nonsmooth_rod.integrators.moreau_jean_loop', '_joints_project',
          '(float64[::1], int64, int64[::1], int64[::1], float64[:, ::1], float64[:, ::1], int64[:, ::1], float64[::1], float64[:, ::1], float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], float64[:, ::1], float64[::1])'),
         ('nonsmooth_rod.integrators.moreau_jean_loop', 'broad_candidates',
-         '(float64, float64, float64[::1], float64[::1], float64[:, ::1], int64[::1], int64[::1], int64[::1], float64[:, ::1], int64[:, ::1], int64[::1], int64[::1], float64[::1], int64[::1], float64[::1])'),
+         '(float64, float64, float64[::1], float64[::1], float64[:, ::1], int64[::1], int64[::1], int64[::1], float64[:, ::1], int64[:, ::1], int64[::1], int64[::1], float64[::1], int64[::1], float64[::1], int64[::1])'),
         ('nonsmooth_rod.solvers.two_coefficient', '_hold_search',
          '(float64[:, ::1], int64[::1], int64[::1], float64[:, :, ::1], float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], float64, float64[::1], float64[::1], float64[::1], int64[::1], float64[::1])'),
     ),

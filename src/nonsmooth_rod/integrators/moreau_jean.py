@@ -191,8 +191,10 @@ LENT_WINDOW_BYTES = 1 << 18
 
 
 # Record columns a window starts with, per body (at least MIN_RECORD_COLUMNS; at most one a
-# contact): a tower of 5 boxes has 36 candidates among its 340 found contacts; more widen it.
-RECORD_COLUMNS_PER_BODY, MIN_RECORD_COLUMNS = 8, 16
+# contact): a tower of 5 boxes has 20 candidates among its 340 found contacts (each box's corners
+# on the top below and the floor, the top corners below on its bottom edge); more widen it. Each
+# column is a step's 4 records: a 5000-step window of 8 a body wrote (zeroed) 6.4 MB for the tower.
+RECORD_COLUMNS_PER_BODY, MIN_RECORD_COLUMNS = 4, 16
 
 
 def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int, slip_default) -> Window:

@@ -35,13 +35,14 @@ from .._jit import jit, jit_borrowing
 _inlined = _jit.jit_inline  # the small per-contact helpers, compiled into the step's functions
 from ..model.contact_kernels import (C_LINE_PX, C_LINE_PY, C_NX, C_NY, C_OBSTACLE_START_VX, C_OBSTACLE_START_VY,
                                       C_OBSTACLE_VX, C_OFF_AX, C_OFF_AY, C_RADIUS_A, C_RADIUS_B, C_SURFACE_VELOCITY,
-                                      C_MOTION,
-                                      KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity)
+                                      C_MOTION, KIND_FIXED_VERTEX_ON_EDGE, KIND_VERTEX_ON_EDGE,
+                                      KIND_DISK_ON_DISK, KIND_DISK_ON_LINE, KIND_DISK_ON_SEGMENT, obstacle_velocity,
+                                      vertex_cone_margin)
 from ..model.forces import accumulate_forces
 from .carved import carve_zeros
 from ..model.joints import ROWS_PER_JOINT, jointed_dofs
 from ..model.motion import NOW_END, NOW_VELOCITY, evaluate_motions
-from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_KIND,
+from ..model.packing import (C_MU_D, C_MU_S, C_RESTITUTION, CI_BODY_A, CI_BODY_B, CI_KIND,
                              contact_kinematics, drive_contacts, row_dot)
 from ..solvers.kernels import carve, carve_matrix, solver_scratch, takes_block_sparse
 from .joint_step import (constrained_delassus, held_contact_rows, joint_operators, joint_views, project_onto_joints,
@@ -375,12 +376,37 @@ BROAD_PHASE_REBUILD = 0.45
 @jit
 def kept_sizes(n_dof, n_circles, n_contacts, n_pairs):
     """The sizes of Scratch.kept (ints: the counts of kept pairs and lines, a (contact, circle,
-    circle) triple per kept pair, the kept lines' contacts) and Scratch.kept_pose (floats, _pose_views:
+    circle) triple per kept pair, the kept lines' contacts, then at _visits_at the step's visit
+    list: its count, −1 while none, and its contacts) and Scratch.kept_pose (floats, _pose_views:
     q at the build, each body's lever, the skin and 1 once built; then the circles' centres, the q
     they were placed at and each circle's lever); none without a broad phase."""
     if n_pairs <= BROAD_PHASE_MIN_PAIRS:
         return 0, 0
-    return 2 + 3 * n_pairs + n_contacts, 2 * n_dof + n_dof // 3 + 2 + 3 * n_circles
+    return 3 + 3 * n_pairs + 2 * n_contacts, 2 * n_dof + n_dof // 3 + 2 + 3 * n_circles
+
+
+@_inlined
+def _visits_at(pair_keys, table):
+    """Where Scratch.kept's visit list starts (kept_sizes): its count (−1: none), then its contacts."""
+    return 2 + 3 * pair_keys.shape[0] + table.shape[0]
+
+
+@_inlined
+def _visits(kept, pair_keys, table):
+    """(count, start) of the contacts the step's loops visit: the kept list's visit list while it has
+    one (_keep_near: every contact that may be a candidate or has a column of the records until the
+    next build, in order — the others are out of reach, with zero rows and no records to write),
+    else every contact (start −1)."""
+    if kept.shape[0] > 0:
+        at = _visits_at(pair_keys, table)
+        if kept[at] >= 0:
+            return kept[at], at + 1
+    return table.shape[0], -1
+
+
+# broad_candidates' outcomes: no kept list (the whole broad phase ran), a kept list built at this
+# step, the kept list of an earlier step reused.
+NO_KEPT_LIST, KEPT_LIST_BUILT, KEPT_LIST_REUSED = 0, 1, 2
 
 
 @_inlined
@@ -424,10 +450,12 @@ def _circles_now(h, q, v, disks, disk_body, x, y, placed, levers, reach, turn):
 
 @jit_borrowing
 def broad_candidates(h, gamma, q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate,
-                     room, kept, kept_pose):
+                     room, kept, kept_pose, column):
     """The step's broad phase: the candidates _mark_candidates and lines_in_reach(γ h) mark, tested
-    by the same tests but only over a kept list (Scratch.kept; _keep_near builds it) while no body
-    has moved past the skin since its build (empty kept, or no room: those two on every contact).
+    by the same tests but only over a kept list (Scratch.kept; _keep_near builds it, with the
+    visit list of the contacts that may be candidates or have a column of the records `column`)
+    while no body has moved past the skin since its build (empty kept, or no room: those two on
+    every contact). Returns NO_KEPT_LIST, KEPT_LIST_BUILT or KEPT_LIST_REUSED.
 
     Why the kept list holds every candidate: a circle at offset o (lever ℓ = |o| + r ≤ L, its
     body's lever) has its centre within D = |Δx|₁ + |Δθ| L of where it was at the build, and its
@@ -439,16 +467,23 @@ def broad_candidates(h, gamma, q, v, disks, disk_body, pair_keys, pair_contact, 
     clearance at the build less D + S, so one that cleared s/2 at the build is still out; a
     driven or moving line's contacts are always kept. A contact closed at the build is kept, and
     one closes later only as a candidate, hence kept. Each step then marks exactly what the
-    full broad phase marks (tests/integrators/test_broad_phase.py), so results are unchanged."""
+    full broad phase marks, less the vertex–edge pairs whose cone rule rejects them at every pose
+    until the next build (_out_of_cone_until_rebuilt: the kernel would give them an infinite gap
+    and zero rows, the records of a contact out of reach — finish_arrays), so results are
+    unchanged (tests/integrators/test_broad_phase.py)."""
     n, n_dof = disks.shape[0], q.shape[0]
     if kept.shape[0] == 0 or kept_pose.shape[0] == 0 or n + 4 * (n_dof // 3) > room.shape[0]:
         _mark_candidates(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate, room)
         lines_in_reach(h * abs(gamma), q, v, table, index, was_closed, candidate)
-        return
+        if kept.shape[0] > 0:
+            kept[_visits_at(pair_keys, table)] = -1  # no visit list: the step visits every contact
+        return NO_KEPT_LIST
     pose, x, y, placed, levers = _pose_views(kept_pose, n_dof, n)
+    outcome = KEPT_LIST_REUSED
     if pose[n_dof + n_dof // 3 + 1] == 0.0 or _past_skin(h * max(1.0, abs(gamma)), q, v, pose):
         _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate, kept,
-                   kept_pose)
+                   kept_pose, column)
+        outcome = KEPT_LIST_BUILT
     reach, at = carve(room, 0, n)
     turn, at = carve(room, at, 4 * (n_dof // 3))
     _circles_now(h, q, v, disks, disk_body, x, y, placed, levers, reach, turn)
@@ -461,6 +496,7 @@ def broad_candidates(h, gamma, q, v, disks, disk_body, pair_keys, pair_contact, 
         out = not was_closed[i] and (_line_clearance(h * abs(gamma), q, v, table, index, i)
                                      > ACTIVATION_ROUNDOFF + BROAD_PHASE_SLACK)
         candidate[i] = 0 if out else 1
+    return outcome
 
 
 @_inlined
@@ -481,12 +517,16 @@ def _past_skin(step, q, v, kept_pose):
 
 
 @jit
-def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate, kept, kept_pose):
+def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, was_closed, candidate, kept, kept_pose,
+               column):
     """Build the kept list at pose q (broad_candidates): the listed circle pairs within each
     other's radius + s/2 + slack or closed (found as the broad phase finds pairs in reach:
     each tested, or swept), and the points on lines closed, on a driven or moving line, or
-    within s/2 of it; every other such contact's candidate set to 0 until the next build (the
-    contacts the broad phase never leaves out: 1). Records the pose, the levers and the skin."""
+    within s/2 of it, less the vertex–edge pairs the cone rule rejects until the next build
+    (_out_of_cone_until_rebuilt); every other such contact's candidate set to 0 until the next
+    build (the contacts the broad phase never leaves out: 1); and the visit list (_visits): those
+    marked and those with a column of the records (`column`, Records.column). Records the pose,
+    the levers and the skin."""
     n, n_dof = disks.shape[0], q.shape[0]
     pose, x, y, placed, levers = _pose_views(kept_pose, n_dof, n)
     skin = _skin_and_levers(disks, disk_body, table, index, pose, n_dof)
@@ -509,6 +549,9 @@ def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, wa
     for j in range(pair_keys.shape[0]):
         while pair_keys[j] >= (da + 1) * n:
             da += 1
+        if candidate[pair_contact[j]] and _out_of_cone_until_rebuilt(pair_contact[j], q, table, index, was_closed,
+                                                                     pose, skin):
+            candidate[pair_contact[j]] = 0
         if candidate[pair_contact[j]]:
             kept[2 + 3 * count], kept[3 + 3 * count], kept[4 + 3 * count] = pair_contact[j], da, pair_keys[j] - da * n
             count += 1
@@ -525,9 +568,43 @@ def _keep_near(q, v, disks, disk_body, pair_keys, pair_contact, table, index, wa
             kept[lines + count] = i
             count += 1
     kept[1] = count
+    at, count = _visits_at(pair_keys, table), 0
+    for i in range(table.shape[0]):
+        if candidate[i] or column[i] > 0:
+            kept[at + 1 + count] = i
+            count += 1
+    kept[at] = count
     for d in range(n_dof):
         pose[d] = q[d]
     pose[n_dof + n_dof // 3 + 1] = 1.0
+
+
+# Added to the bound on a kept vertex–edge pair's cone margin (_out_of_cone_until_rebuilt): the
+# round-off of a few products of unit vectors, with room to spare.
+CONE_MARGIN_SLACK = 1e-9
+
+
+@_inlined
+def _out_of_cone_until_rebuilt(i, q, table, index, was_closed, pose, skin):
+    """Whether contact i, a vertex on an edge not closed, is rejected by the kernel's cone rule at
+    every pose the kept list built at q serves (vertex_cone_margin < 0): its margin now below
+    minus the most the two bodies can turn before a rebuild — |Δθ| L ≤ BROAD_PHASE_REBUILD s for
+    a body of lever L (_past_skin), and the margin moves by at most the relative turn. Such a
+    pair (a box's corner beside the side of the box it sits on) would get an infinite gap and
+    zero rows every step: left out, it costs no kinematics and no column of the records."""
+    kind = index[i, CI_KIND]
+    if was_closed[i] or (kind != KIND_VERTEX_ON_EDGE and kind != KIND_FIXED_VERTEX_ON_EDGE):
+        return False
+    point, edge = index[i, CI_BODY_A], index[i, CI_BODY_B]
+    if kind == KIND_FIXED_VERTEX_ON_EDGE:  # (a segment's end on body a's edge)
+        point, edge = -1, index[i, CI_BODY_A]
+    n_dof = q.shape[0]
+    turn = 0.0
+    for body in (point, edge):
+        if body >= 0:
+            lever = pose[n_dof + body]
+            turn += BROAD_PHASE_REBUILD * skin / lever if lever > 0.0 else math.inf
+    return vertex_cone_margin(table[i], point, edge, q) < -turn - CONE_MARGIN_SLACK
 
 
 @jit_borrowing
@@ -613,11 +690,16 @@ def begin_arrays(params, qk, vk, f, minv, table, index, disks, disk_body, pair_k
     if joints.shape[0] > 0:
         _joints_begin(qk, minv, joints, joint_buffer, v_free, a_free)
     broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # enough disk pairs for sorting to pay
+    outcome = NO_KEPT_LIST
     if broad:
-        broad_candidates(h, gamma, qk, vk, disks, disk_body, pair_keys, pair_contact, table, index, was_closed,
-                         candidate, room, kept, kept_pose)
+        outcome = broad_candidates(h, gamma, qk, vk, disks, disk_body, pair_keys, pair_contact, table, index,
+                                   was_closed, candidate, room, kept, kept_pose, out.column)
+    # on a reused kept list, its visit list (every other contact out of reach since the build, its
+    # rows zeroed by the build's step, which visits every contact)
+    n_visits, start = _visits(kept, pair_keys, table) if outcome == KEPT_LIST_REUSED else (table.shape[0], -1)
     na = 0
-    for i in range(table.shape[0]):
+    for e in range(n_visits):
+        i = kept[start + e] if start >= 0 else e
         if broad and not candidate[i]:
             # out of reach this step: no kinematics. An infinite gap comes with zero rows (a pair
             # the kernel rejects gets them too): rows already zeroed are not written again.
@@ -862,7 +944,7 @@ def finish_step(k, params, iparams, na, p, u, states, qk, vk, model, work, out):
     return finish_arrays(k, params, iparams, na, p, u, states, qk, vk, model.minv, model.contacts,
                          model.contact_index, model.pair_keys, model.joints, work.joint_buffer, work.gaps,
                          work.drifts, work.hn, work.ht, work.active, work.was_closed, work.grazing, work.slip_sign,
-                         work.v_free, work.a_free, work.candidate, out)
+                         work.v_free, work.a_free, work.candidate, out, np.empty(0, dtype=np.int64))
 
 
 @_inlined
@@ -881,11 +963,33 @@ def _end_velocity(na, p, minv, index, hn, ht, active, v_free, v_next):
 
 
 @_inlined
+def _open_records(k, n_visits, start, kept, broad, table, index, gaps, hn, ht, grazing, candidate, v_next, out):
+    """Step k's records of the visited contacts (_visits) as if none acted — p = 0, open, the slip
+    at v_{k+1} — and their grazing cleared: finish_arrays then writes the active ones' over them."""
+    column, p_normal, p_tangent, slip, state_rec = out.column, out.p_normal, out.p_tangent, out.slip, out.states
+    for e in range(n_visits):
+        i = kept[start + e] if start >= 0 else e
+        grazing[i] = 0
+        c = column[i] - 1  # contact i's records' column (−1: none, never a candidate)
+        if c < 0:
+            continue  # no records to write: those of a contact out of reach (_open_column)
+        p_normal[k, c] = 0.0
+        p_tangent[k, c] = 0.0
+        state_rec[k, c] = 0
+        if (not broad or candidate[i]) and gaps[i] != math.inf:
+            slip[k, c] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
+        else:  # a contact out of reach, or not the touching pair, has zero rows: only the belt's
+            slip[k, c] = -table[i, C_SURFACE_VELOCITY]  # surface velocity is left (its ±0 not v's)
+
+
+@_inlined
 def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, index, pair_keys, joints, joint_buffer,
-                  gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, out):
+                  gaps, drifts, hn, ht, active, was_closed, grazing, slip_sign, v_free, a_free, candidate, out, kept):
     """End-of-step state, the step's records (`out`: Records), impacts and the contacts' memory;
-    returns a run status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE)."""
-    q, v, p_normal, p_tangent, slip, state_rec = out.q, out.v, out.p_normal, out.p_tangent, out.slip, out.states
+    returns a run status (RUN_OK, RUN_STOPPED at the stop contact's first impact, RUN_NONFINITE).
+    kept: Scratch.kept (empty: none) — its visit list holds every contact with a column or that
+    may be a candidate (_visits): the others have no records to write and no memory to change."""
+    q, v, p_normal, p_tangent, state_rec = out.q, out.v, out.p_normal, out.p_tangent, out.states
     impact_t, impact_step, impact_contact = out.impact_t, out.impact_step, out.impact_contact
     counters, joint_impulse, column = out.counters, out.joint_impulse, out.column  # (column: _open_column)
     h, theta = params[P_H], params[P_THETA]
@@ -904,18 +1008,8 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
                         a_free, table, v_next)
     status = RUN_OK
     broad = pair_keys.shape[0] > BROAD_PHASE_MIN_PAIRS  # as begin_arrays' broad phase
-    for i in range(table.shape[0]):
-        grazing[i] = 0
-        c = column[i] - 1  # contact i's records' column (−1: none, never a candidate)
-        if c < 0:
-            continue  # no records to write: those of a contact out of reach (_open_column)
-        p_normal[k, c] = 0.0
-        p_tangent[k, c] = 0.0
-        state_rec[k, c] = 0
-        if not broad or candidate[i]:
-            slip[k, c] = relative_slip_velocity(table, hn, ht, index, i, v_next, False)
-        else:  # a contact out of reach has zero rows: only the belt's surface velocity is left
-            slip[k, c] = -table[i, C_SURFACE_VELOCITY]
+    n_visits, start = _visits(kept, pair_keys, table)
+    _open_records(k, n_visits, start, kept, broad, table, index, gaps, hn, ht, grazing, candidate, v_next, out)
     for a in range(na):
         i = active[a]
         c = column[i] - 1  # (an active contact is a candidate: it has its column)
@@ -924,7 +1018,8 @@ def finish_arrays(k, params, iparams, na, p, u, states, qk, vk, minv, table, ind
                                                                         table, index, v_next):
             grazing[i] = 1  # no force this step (reported open), yet not apart: no impact on return
         slip_sign[i] = 1.0 if states[a] == STATE_SLIP_PLUS else (-1.0 if states[a] == STATE_SLIP_MINUS else 0.0)
-    for i in range(table.shape[0]):
+    for e in range(n_visits):
+        i = kept[start + e] if start >= 0 else e
         if broad and not candidate[i]:
             continue  # no impulse, not grazing, and not closed before (a closed contact is a candidate)
         closed = p_normal[k, column[i] - 1] > 0.0
@@ -1134,7 +1229,7 @@ def step_arrays(solver_code, k, f, params, iparams, model, work, out, scratch):
             return RUN_SOLVER_FAILED
     status = finish_arrays(k, params, iparams, na, p, u, states, qk, vk, m.minv, m.contacts, m.contact_index,
                            m.pair_keys, m.joints, w.joint_buffer, w.gaps, w.drifts, w.hn, w.ht, w.active,
-                           w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o)
+                           w.was_closed, w.grazing, w.slip_sign, w.v_free, w.a_free, w.candidate, o, scratch.kept)
     if m.driven.shape[0] > 0:
         place_driven_arrays(k, m.driven, m.driven_origin, m.motion_now, o.q, o.v)
     return status

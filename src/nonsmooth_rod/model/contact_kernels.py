@@ -256,6 +256,20 @@ def _cone_margin(row, dx, dy, ca, sa):
 
 
 @jitable
+def vertex_cone_margin(row, point_body, edge_body, q):
+    """The cone rule's margin (_cone_margin, a sine) of a vertex–edge row at q: the kernel never
+    counts the pair where it is < 0 (+inf for a disk: no cone rule). A difference of products of
+    unit directions turned by the two bodies' angles: it changes by at most their relative turn
+    (the broad phase's kept list leaves out the pairs it keeps below 0, moreau_jean_loop._keep_near)."""
+    if row[C_RADIUS_A] != 0.0:
+        return math.inf
+    ca, sa = _frame(point_body, q, q, row, C_OFF_AX, C_OFF_AY)[:2]
+    cb, sb = _frame(edge_body, q, q, row, C_OFF_BX, C_OFF_BY)[:2]
+    tx, ty = cb * row[C_EDGE_TX] - sb * row[C_EDGE_TY], sb * row[C_EDGE_TX] + cb * row[C_EDGE_TY]
+    return _cone_margin(row, -ty, tx, ca, sa)
+
+
+@jitable
 def _least_penetrated(row, dx, dy, height, tx, ty, length, cb, sb, ca, sa, is_vertex):
     """Whether the point at d = P − E (world axes; `height` its signed distance above the edge)
     is no deeper behind this edge than behind either neighbouring edge it could touch instead
