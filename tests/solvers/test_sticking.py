@@ -481,7 +481,8 @@ def test_held_set_trials_through_the_shared_factorization_are_the_general_ones(c
         candidates, release = np.empty(na, dtype=np.int64), np.empty(na)
         n_c = kernel("_resting_contacts")(np.zeros(na), p, u, np.zeros(na), states, tol, candidates, release, False)
         mode, sign = np.zeros(na, dtype=np.int64), np.zeros(na)
-        shared = kernel("_bordered_trials")(W, mu_d, candidates, release, n_c, u, states, mode, sign)
+        shared = kernel("_bordered_trials")(W, mu_d, candidates, release, n_c, u, states, mode, sign,
+                                            *kernel("search_scratch")(na))
         for held in range(1 << n_c):
             kernel("_modes_for")(held, candidates, release, n_c, u, states, mode, sign, False)
             p_fast, p_general = np.zeros(2 * na), np.zeros(2 * na)
@@ -571,7 +572,8 @@ def test_pruning_lps_on_the_shared_relaxation_decide_as_the_general_ones(compile
         candidates, release = np.empty(na, dtype=np.int64), np.empty(na)
         n_c = kernel("_resting_contacts")(np.zeros(na), p, u, np.zeros(na), states, tol, candidates, release, False)
         mode, sign = np.zeros(na, dtype=np.int64), np.zeros(na)
-        relaxed = kernel("_relaxed_base")(W, mu_d, candidates, release, n_c, u, states, mode, sign)
+        relaxed = kernel("_relaxed_base")(W, mu_d, candidates, release, n_c, u, states, mode, sign,
+                                          *kernel("search_scratch")(na))
         for c in range(n_c):
             kernel("_modes_for")(1 << c, candidates, release, n_c, u, states, mode, sign, True)
             i = candidates[c]
@@ -589,3 +591,26 @@ def test_pruning_lps_on_the_shared_relaxation_decide_as_the_general_ones(compile
             for split in (p_shared, p_general):  # both on the check's boundary
                 assert abs(_law_ratio(W, q, mode, sign, mu_s, split, tol, scale) - 1.0) <= 1e-3
     assert vouched > 20 and agreed >= 0.8 * vouched and vouched >= 4 * declined
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_trials_small_inverse_is_the_packages_lu_inverse(compiled):
+    """_small_inverse (a held-set trial's Schur complement, through kernel_base's LU into scratch)
+    inverts the leading s × s block of its input to round-off of its condition (against numpy's
+    inverse), and fills infinities for a singular block — which then fail _bordered_split's
+    certificate (a finite Frobenius norm is required)."""
+    invert = sticking._small_inverse if compiled else _interpreted(sticking._small_inverse)
+    rng = np.random.default_rng(5)
+    for s in range(0, 9):
+        S = np.full((12, 12), np.nan)  # entries beyond the block must not be read
+        S[:s, :s] = rng.normal(size=(s, s)) + 3.0 * np.eye(s)
+        LU, inverse = np.empty((s, s)), np.empty((s, s))
+        invert(S, s, LU, np.empty(s, dtype=np.int64), inverse)
+        expected = np.linalg.inv(S[:s, :s]) if s else np.zeros((0, 0))
+        condition = np.linalg.cond(S[:s, :s]) if s else 1.0
+        size = max(1.0, np.abs(expected).max(initial=0.0))
+        assert np.allclose(inverse, expected, rtol=0.0, atol=50 * condition * np.finfo(float).eps * size)
+    singular = np.array([[1.0, 2.0], [2.0, 4.0]])
+    inverse = np.empty((2, 2))
+    invert(singular, 2, np.empty((2, 2)), np.empty(2, dtype=np.int64), inverse)
+    assert np.all(np.isinf(inverse))

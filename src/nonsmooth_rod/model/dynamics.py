@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._jit import jit
+from ..solvers.kernel_base import lu_factor, lu_solve
 from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, C_OBSTACLE_VX, C_OBSTACLE_VY,
                               C_SURFACE_VELOCITY, KIND_DISK_ON_LINE, N_CONTACT_COLUMNS, _on_fixed_normal,
                               obstacle_velocity)
@@ -357,28 +358,17 @@ def _solve_mode(C, G, base, owner, role, M, minv, free, table, ints, out, k) -> 
 @jit
 def _eliminate(M) -> float:
     """Gaussian elimination with partial pivoting of the augmented M = [A | b], in place: the last
-    column becomes x (where A is regular); returns det A."""
+    column becomes x (where A is regular); returns det A (0 when a pivot is zero). The package's
+    one LU (solvers.kernel_base.lu_factor, lu_solve): the same operations in the same order as
+    eliminating b along with A."""
     m = M.shape[0]
+    rows = np.empty(m, dtype=np.int64)
+    if not lu_factor(M, m, rows, 0.0):
+        return 0.0
     det = 1.0
     for k in range(m):
-        p = k
-        for i in range(k + 1, m):
-            if abs(M[i, k]) > abs(M[p, k]):
-                p = i
-        if p != k:
-            for j in range(k, m + 1):
-                M[k, j], M[p, j] = M[p, j], M[k, j]
+        if rows[k] != k:
             det = -det
         det *= M[k, k]
-        if M[k, k] == 0.0:
-            return 0.0
-        for i in range(k + 1, m):
-            factor = M[i, k] / M[k, k]
-            for j in range(k + 1, m + 1):
-                M[i, j] -= factor * M[k, j]
-    for k in range(m - 1, -1, -1):
-        x = M[k, m]
-        for j in range(k + 1, m):
-            x -= M[k, j] * M[j, m]
-        M[k, m] = x / M[k, k]
+    lu_solve(M, m, rows, M[:, m])
     return det

@@ -87,6 +87,52 @@ def problem_scale(q, p, u) -> float:
     return scale if scale > 0.0 else 1.0
 
 
+# ---------------------------------------------------------------- dense elimination
+# The package's one dense LU (partial pivoting, in place, borrowing: it allocates nothing): Lemke's
+# warm answer, the hold search's bordered trials (sticking) and the event-driven reference's mode
+# equations (model.dynamics) factor and solve with it.
+
+
+@jit_borrowing
+def lu_factor(A, m, rows, pivot_tol):
+    """A = P L U in place (L's multipliers below the diagonal, rows[c]: the row swapped into c),
+    partial pivoting; False when the largest pivot left is ≤ pivot_tol: A singular to round-off."""
+    for c in range(m):
+        r = c
+        for i in range(c + 1, m):
+            if abs(A[i, c]) > abs(A[r, c]):
+                r = i
+        if abs(A[r, c]) <= pivot_tol:
+            return False
+        rows[c] = r
+        if r != c:
+            for j in range(m):
+                A[c, j], A[r, j] = A[r, j], A[c, j]
+        for i in range(c + 1, m):
+            factor = A[i, c] / A[c, c]
+            A[i, c] = factor
+            if factor != 0.0:
+                for j in range(c + 1, m):
+                    A[i, j] -= factor * A[c, j]
+    return True
+
+
+@jit_borrowing
+def lu_solve(A, m, rows, x):
+    """x ← A⁻¹ x with A factored by lu_factor (its swaps moved whole rows, L's multipliers too:
+    all of them apply to x first)."""
+    for c in range(m):
+        r = rows[c]
+        if r != c:
+            x[c], x[r] = x[r], x[c]
+    for c in range(m):
+        for i in range(c + 1, m):
+            x[i] -= A[i, c] * x[c]
+    for c in range(m - 1, -1, -1):
+        value = x[c]
+        for j in range(c + 1, m):
+            value -= A[c, j] * x[j]
+        x[c] = value / A[c, c]
 
 
 # ---------------------------------------------------------------- per-run scratch

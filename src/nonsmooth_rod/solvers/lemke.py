@@ -54,7 +54,7 @@ from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit, jit_borrowing
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
-from .kernel_base import carve, carve_matrix, problem_scale, solver_scratch, step_residual
+from .kernel_base import carve, carve_matrix, lu_factor, lu_solve, problem_scale, solver_scratch, step_residual
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -502,15 +502,15 @@ def warm_interval_answer(W, q, lo, hi, p, u, rtol, room, support):
         for b in range(m):
             A[a, b] = _interval_entry(W, lo, hi, support[a], support[b])
             largest = max(largest, abs(A[a, b]))
-    if not _lu_factor(A, m, rows, PIVOT_TOL * largest):
+    if not lu_factor(A, m, rows, PIVOT_TOL * largest):
         return -1.0
-    _lu_solve(A, m, rows, x)
+    lu_solve(A, m, rows, x)
     for a in range(m):  # the refinement: the residual of the original rows, solved again
         value = -_interval_q(q, support[a])
         for b in range(m):
             value -= _interval_entry(W, lo, hi, support[a], support[b]) * x[b]
         correction[a] = value
-    _lu_solve(A, m, rows, correction)
+    lu_solve(A, m, rows, correction)
     for r in range(2 * lo.shape[0]):
         p[r] = 0.0
     for a in range(m):
@@ -545,48 +545,6 @@ def _interval_entry(W, lo, hi, r, c):
     if column_kind == 0:
         return W[row, 2 * j] + lo[j] * W[row, 2 * j + 1]
     return W[row, 2 * j + 1]
-
-
-@jit_borrowing
-def _lu_factor(A, m, rows, pivot_tol):
-    """A = P L U in place (L's multipliers below the diagonal, rows[c]: the row swapped into c),
-    partial pivoting; False when the largest pivot left is ≤ pivot_tol: A singular to round-off."""
-    for c in range(m):
-        r = c
-        for i in range(c + 1, m):
-            if abs(A[i, c]) > abs(A[r, c]):
-                r = i
-        if abs(A[r, c]) <= pivot_tol:
-            return False
-        rows[c] = r
-        if r != c:
-            for j in range(m):
-                A[c, j], A[r, j] = A[r, j], A[c, j]
-        for i in range(c + 1, m):
-            factor = A[i, c] / A[c, c]
-            A[i, c] = factor
-            if factor != 0.0:
-                for j in range(c + 1, m):
-                    A[i, j] -= factor * A[c, j]
-    return True
-
-
-@jit_borrowing
-def _lu_solve(A, m, rows, x):
-    """x ← A⁻¹ x with A factored by _lu_factor (its swaps moved whole rows, L's multipliers too:
-    all of them apply to x first)."""
-    for c in range(m):
-        r = rows[c]
-        if r != c:
-            x[c], x[r] = x[r], x[c]
-    for c in range(m):
-        for i in range(c + 1, m):
-            x[i] -= A[i, c] * x[c]
-    for c in range(m - 1, -1, -1):
-        value = x[c]
-        for j in range(c + 1, m):
-            value -= A[c, j] * x[j]
-        x[c] = value / A[c, c]
 
 
 @jit_borrowing

@@ -29,6 +29,7 @@ import numpy as np
 
 from .._jit import jit
 from .delassus import coupled_components, group_matrix
+from .kernel_base import carve, carve_matrix, lu_factor, lu_solve
 from .problem import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK
 
 MODE_OPEN, MODE_STICK, MODE_SLIDE = 0, 1, 2
@@ -40,6 +41,7 @@ MODE_FREE = 3
 MODE_LOOSE = 4
 MAX_CANDIDATES = 16  # contacts that survive the pruning considered for a held set (beyond: the first 16)
 MAX_TRIALS = 64  # feasibility problems per step at most
+BORDER_MAX = 2 * MAX_CANDIDATES  # entries a held-set trial adds to its base (two per candidate that lifts)
 SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driven LP
 PIVOT_TOL = 1e-11
 RANK_TOL = 1e-10  # singular values below RANK_TOL × the largest span the indeterminate splits
@@ -55,15 +57,16 @@ def _pivot(T, basis, r, j, cols):
     entry by entry: compiled, each row expression `T[i, :] -= c * T[r, :]` allocated its
     temporary (a third of a hold search's cost), and the rank-one update that replaced it
     (`np.outer`) a whole tableau per pivot. Only the columns where the pivot row is non-zero are
-    updated (their indices gathered in `cols`, int64 scratch of T's width): elsewhere the update
-    subtracts an exact zero and leaves the entry as it is, so the same products and the same
-    rounding as the full update — and a fraction of its work, the tableau's slack columns being
-    mostly zero in the pivot row (the hold search's LPs: ~95 × 125). Rows with T[i, j] = 0 are
-    skipped."""
-    T[r, :] /= T[r, j]
+    divided and updated (their indices gathered in `cols`, int64 scratch of T's width): elsewhere
+    the division leaves a zero and the update subtracts an exact zero, so the same products and
+    the same rounding as the full update — and a fraction of its work, the tableau's slack columns
+    being mostly zero in the pivot row (the hold search's LPs: ~95 × 125). Rows with T[i, j] = 0
+    are skipped."""
+    pivot = T[r, j]
     n_cols = 0
     for col in range(T.shape[1]):
         if T[r, col] != 0.0:
+            T[r, col] /= pivot
             cols[n_cols] = col
             n_cols += 1
     for i in range(T.shape[0]):
@@ -76,14 +79,16 @@ def _pivot(T, basis, r, j, cols):
 
 @jit
 def _set_objective(T, basis, cost):
-    """Objective row of T: reduced costs cost_j − c_Bᵀ T[:, j] (last entry −objective value)."""
+    """Objective row of T: reduced costs cost_j − c_Bᵀ T[:, j] (last entry −objective value).
+    Entry by entry: the row expression allocated its temporary."""
     m = T.shape[0] - 1
-    T[m, :] = 0.0
-    T[m, : cost.shape[0]] = cost
+    for col in range(T.shape[1]):
+        T[m, col] = cost[col] if col < cost.shape[0] else 0.0
     for i in range(m):
         cb = cost[basis[i]]
         if cb != 0.0:
-            T[m, :] -= cb * T[i, :]
+            for col in range(T.shape[1]):
+                T[m, col] -= cb * T[i, col]
 
 
 @jit
@@ -115,6 +120,36 @@ def _run_simplex(T, basis, n_allowed, max_iter, cols):
 
 
 @jit
+def simplex_floats(m, n):
+    """Floats simplex_in takes for m constraints on n unknowns: its tableau, cost row and c."""
+    return (m + 1) * (n + m + 2) + (n + m + 1) + n
+
+
+@jit
+def simplex_ints(m, n):
+    """int64s simplex_in takes: the basis and the pivot's column list."""
+    return m + (n + m + 2)
+
+
+@jit
+def simplex_tableau(floats, ints, m, n):
+    """(T, basis, cols, cost, c) carved from scratch (simplex_floats, simplex_ints) for m
+    constraints on n unknowns: T zero but for the phase-1 column (−1) and the slacks' identity,
+    every slack basic; the caller writes G, h (T[i, :n], T[i, −1]) and c."""
+    T, at = carve_matrix(floats, 0, m + 1, n + m + 2)
+    cost, at = carve(floats, at, n + m + 1)
+    c, at = carve(floats, at, n)
+    basis, at_int = carve(ints, 0, m)
+    cols, at_int = carve(ints, at_int, n + m + 2)
+    T[:, :] = 0.0
+    for i in range(m):
+        T[i, n] = -1.0
+        T[i, n + 1 + i] = 1.0
+        basis[i] = n + 1 + i
+    return T, basis, cols, cost, c
+
+
+@jit
 def simplex_max(c, G, h, x):
     """max cᵀx subject to G x ≤ h, x ≥ 0 (dense two-phase simplex, Bland's rule).
 
@@ -122,26 +157,34 @@ def simplex_max(c, G, h, x):
     violated row. Fills x; returns 0 optimal, 1 unbounded, 2 iteration limit, 3 infeasible.
     """
     m, n = G.shape
-    T = np.zeros((m + 1, n + m + 2))
-    basis = np.empty(m, dtype=np.int64)
-    cols = np.empty(n + m + 2, dtype=np.int64)  # _pivot's scratch
+    floats, ints = np.empty(simplex_floats(m, n)), np.empty(simplex_ints(m, n), dtype=np.int64)
+    T, basis, cols, cost, c_in = simplex_tableau(floats, ints, m, n)
+    h_largest = 0.0
     for i in range(m):
         T[i, :n] = G[i, :]
-        T[i, n] = -1.0
-        T[i, n + 1 + i] = 1.0
         T[i, -1] = h[i]
-        basis[i] = n + 1 + i
+        h_largest = max(h_largest, abs(h[i]))
+    c_in[:] = c
+    return simplex_in(T, basis, cols, cost, c_in, h_largest, x)
+
+
+@jit
+def simplex_in(T, basis, cols, cost, c, h_largest, x):
+    """simplex_max on a tableau simplex_tableau carved and the caller filled with G and h
+    (h_largest: max |h|, for the phase-1 test). Allocates nothing."""
+    m = T.shape[0] - 1
+    n = c.shape[0]
     max_iter = 50 * (n + m + 2)
     worst = np.int64(0)
     for i in range(m):
-        if h[i] < h[worst]:
+        if T[i, -1] < T[worst, -1]:
             worst = i
-    cost = np.zeros(n + m + 1)
-    if m > 0 and h[worst] < 0.0:
+    cost[:] = 0.0
+    if m > 0 and T[worst, -1] < 0.0:
         cost[n] = -1.0
         _pivot(T, basis, worst, n, cols)
         _set_objective(T, basis, cost)
-        if _run_simplex(T, basis, n + m + 1, max_iter, cols) != 0 or -T[m, -1] < -1e-10 * (1.0 + np.max(np.abs(h))):
+        if _run_simplex(T, basis, n + m + 1, max_iter, cols) != 0 or -T[m, -1] < -1e-10 * (1.0 + h_largest):
             return 3
         for i in range(m):
             if basis[i] == n:  # degenerate: x_a = 0 basic; swap it for any usable column
@@ -286,44 +329,50 @@ def _particular_and_null(A, b):
 
 
 @jit
-def _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale):
+def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_tol, scale, G, h, weight):
     """Rows (G, h, weight) of  g0 + g·z ≥ weight·t  for every law the split must keep, in
     impulse units divided by `scale`: p_N ≥ t and μs p_N ∓ p_T ≥ t (weight 1, the margins);
-    slip direction kept s u_T ≥ −tol and open contacts u_N ≥ −tol (weight 0, hard)."""
+    slip direction kept s u_T ≥ −tol and open contacts u_N ≥ −tol (weight 0, hard). u0 = W p0 + q,
+    Wz = W Pz, w_scale = max |W|; written into G, h, weight (4 rows per contact at most), and
+    returns how many rows."""
     na = mode.shape[0]
     k = Pz.shape[1]
-    u0 = W @ p0 + q
-    Wz = W @ Pz
-    w_scale = max(1e-300, np.max(np.abs(W)))
-    G = np.zeros((4 * na, k))
-    h = np.zeros(4 * na)
-    weight = np.zeros(4 * na)
     n = 0
     for i in range(na):
         if mode[i] == MODE_OPEN:  # velocities in impulse units: divided by max|W|
-            G[n] = Wz[2 * i] / w_scale
-            h[n] = (u0[2 * i] + velocity_tol) / w_scale
+            _law_row(G, h, weight, n, Wz, 2 * i, 1.0, w_scale, u0[2 * i] + velocity_tol, 0.0)
             n += 1
             continue
-        G[n] = Pz[2 * i]
-        h[n] = p0[2 * i]
-        weight[n] = 1.0
+        _law_row(G, h, weight, n, Pz, 2 * i, 1.0, 1.0, p0[2 * i], 1.0)
         n += 1
         if mode[i] == MODE_LOOSE:  # u_N ≥ −tol/2 in place of u_N = 0 (the margin pushes it to the
-            G[n] = Wz[2 * i] / w_scale   # bound: half, so that round-off stays within the final check's)
-            h[n] = (u0[2 * i] + 0.5 * velocity_tol) / w_scale
+            # bound: half, so that round-off stays within the final check's)
+            _law_row(G, h, weight, n, Wz, 2 * i, 1.0, w_scale, u0[2 * i] + 0.5 * velocity_tol, 0.0)
             n += 1
         if mode[i] == MODE_STICK or mode[i] == MODE_FREE or mode[i] == MODE_LOOSE:
             for side in (-1.0, 1.0):
-                G[n] = mu_s[i] * Pz[2 * i] + side * Pz[2 * i + 1]
+                for j in range(k):
+                    G[n, j] = mu_s[i] * Pz[2 * i, j] + side * Pz[2 * i + 1, j]
                 h[n] = mu_s[i] * p0[2 * i] + side * p0[2 * i + 1]
                 weight[n] = 1.0
                 n += 1
         else:
-            G[n] = sign[i] * Wz[2 * i + 1] / w_scale
-            h[n] = (sign[i] * u0[2 * i + 1] + velocity_tol) / w_scale
+            _law_row(G, h, weight, n, Wz, 2 * i + 1, sign[i], w_scale, sign[i] * u0[2 * i + 1] + velocity_tol, 0.0)
             n += 1
-    return G[:n] / scale, h[:n] / scale, weight[:n]
+    for r in range(n):
+        for j in range(k):
+            G[r, j] /= scale
+        h[r] /= scale
+    return n
+
+
+@jit
+def _law_row(G, h, weight, n, rows, row, factor, divisor, value, row_weight):
+    """Row n: G = factor · rows[row] / divisor (no product for a factor of 1), h = value / divisor."""
+    for j in range(G.shape[1]):
+        G[n, j] = (rows[row, j] if factor == 1.0 else factor * rows[row, j]) / divisor
+    h[n] = value / divisor
+    weight[n] = row_weight
 
 
 @jit
@@ -344,37 +393,59 @@ def _fixed_split_margin(h, weight):
 
 
 @jit
-def _deepest_split(G, h, weight, z):
+def _deepest_split(G, h, weight, z, floats, ints):
     """max t subject to g0 + g·z ≥ weight·t, |z| ≤ SPLIT_BOUND, t ≤ 1 (z, t free; scaled units).
-    Fills z and returns t (−inf when even the hard rows cannot hold)."""
+    Fills z and returns t (−inf when even the hard rows cannot hold). The LP's tableau is written
+    straight into (floats, ints) when they hold it (lp_scratch), else into buffers of its own."""
     m, k = G.shape
     if k == 0:  # the mode fixes the split (a row of balls): no simplex (~0.6 ms on 54 rows)
         return _fixed_split_margin(h, weight)
     n = 2 * k + 2  # z = z⁺ − z⁻, t = t⁺ − t⁻
-    Glp = np.zeros((m + 2 * k + 1, n))
-    hlp = np.zeros(m + 2 * k + 1)
+    rows = m + 2 * k + 1
+    floats, ints = lp_scratch(floats, ints, rows, n)
+    T, basis, cols, cost, c = simplex_tableau(floats, ints, rows, n)
+    h_largest = max(SPLIT_BOUND, 1.0)
     for r in range(m):  # −g·z + weight·t ≤ g0
-        Glp[r, :k] = -G[r]
-        Glp[r, k : 2 * k] = G[r]
-        Glp[r, 2 * k] = weight[r]
-        Glp[r, 2 * k + 1] = -weight[r]
-        hlp[r] = h[r]
-    for j in range(k):
-        Glp[m + 2 * j, j] = 1.0
-        Glp[m + 2 * j + 1, k + j] = 1.0
-        hlp[m + 2 * j] = SPLIT_BOUND
-        hlp[m + 2 * j + 1] = SPLIT_BOUND
-    Glp[m + 2 * k, 2 * k] = 1.0
-    Glp[m + 2 * k, 2 * k + 1] = -1.0
-    hlp[m + 2 * k] = 1.0
-    c = np.zeros(n)
+        for j in range(k):
+            T[r, j] = -G[r, j]
+            T[r, k + j] = G[r, j]
+        T[r, 2 * k] = weight[r]
+        T[r, 2 * k + 1] = -weight[r]
+        T[r, -1] = h[r]
+        h_largest = max(h_largest, abs(h[r]))
+    for j in range(k):  # |z_j| ≤ SPLIT_BOUND: z⁺_j, z⁻_j ≤ SPLIT_BOUND
+        T[m + 2 * j, j] = 1.0
+        T[m + 2 * j + 1, k + j] = 1.0
+        T[m + 2 * j, -1] = SPLIT_BOUND
+        T[m + 2 * j + 1, -1] = SPLIT_BOUND
+    T[m + 2 * k, 2 * k] = 1.0  # t ≤ 1
+    T[m + 2 * k, 2 * k + 1] = -1.0
+    T[m + 2 * k, -1] = 1.0
+    c[:] = 0.0
     c[2 * k] = 1.0
     c[2 * k + 1] = -1.0
-    x = np.zeros(n)
-    if simplex_max(c, Glp, hlp, x) != 0:
+    x, _ = carve(floats, simplex_floats(rows, n), n)
+    if simplex_in(T, basis, cols, cost, c, h_largest, x) != 0:
         return -np.inf
-    z[:] = x[:k] - x[k : 2 * k]
+    for j in range(k):
+        z[j] = x[j] - x[k + j]
     return x[2 * k] - x[2 * k + 1]
+
+
+@jit
+def lp_floats(rows, n):
+    """Floats _deepest_split takes for an LP of `rows` constraints on n unknowns (the simplex's
+    and the LP's solution)."""
+    return simplex_floats(rows, n) + n
+
+
+@jit
+def lp_scratch(floats, ints, rows, n):
+    """(floats, ints) when they hold _deepest_split's LP of `rows` constraints on n unknowns, else
+    buffers of its own."""
+    if floats.shape[0] >= lp_floats(rows, n) and ints.shape[0] >= simplex_ints(rows, n):
+        return floats, ints
+    return np.empty(lp_floats(rows, n)), np.empty(simplex_ints(rows, n), dtype=np.int64)
 
 
 @jit
@@ -404,6 +475,13 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
     mode (MODE_OPEN / MODE_STICK / MODE_SLIDE with slip sign `sign`), with normal
     complementarity (closed: u_N = 0, p_N ≥ 0; open: p = 0, u_N ≥ 0). Fills p_out and returns
     True when one exists within the tolerances, False otherwise (p_out then undefined)."""
+    floats, ints = search_scratch(mode.shape[0])
+    return admissible_split_in(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out, floats, ints)
+
+
+@jit
+def admissible_split_in(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out, floats, ints):
+    """admissible_split with the LP's temporaries in (floats, ints) (search_scratch)."""
     P, rows = _unknowns(mode, sign, mu_d)
     if P.shape[1] == 0:
         return False
@@ -411,21 +489,87 @@ def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
     b = -q[rows]
     x0, Z = _particular_and_null(A, b)
     return _deepest_admissible(W, q, mu_s, mode, sign, P @ x0, np.ascontiguousarray(P @ Z), velocity_tol, scale,
-                               p_out)
+                               p_out, max(1e-300, _max_abs(W)), floats, ints)
 
 
 @jit
-def _deepest_admissible(W, q, mu_s, mode, sign, p0, Pz, velocity_tol, scale, p_out):
+def search_floats(na):
+    """Floats one hold search on na contacts takes (a held-set trial's own, then
+    _deepest_admissible's with up to 2 na unknowns z): allocated once per search, carved by each LP."""
+    return 3 * BORDER_MAX * BORDER_MAX + 2 * BORDER_MAX + 5 * 2 * na + _admissible_floats(na, 2 * na)
+
+
+@jit
+def _admissible_floats(na, k):
+    """Floats _deepest_admissible carves for na contacts and k unknowns z (W p0 + q, W p + q, W Pz,
+    the LP's rows G, h, weight, z, and the LP's own)."""
+    return 4 * na + 2 * na * k + 4 * na * (k + 2) + k + lp_floats(4 * na + 2 * k + 1, 2 * k + 2)
+
+
+@jit
+def search_ints(na):
+    """int64s one hold search on na contacts takes (a trial's and the LP's)."""
+    k = 2 * na
+    return 2 * BORDER_MAX + simplex_ints(4 * na + 2 * k + 1, 2 * k + 2)
+
+
+@jit
+def search_scratch(na):
+    """(floats, ints) for one hold search on na contacts."""
+    return np.empty(search_floats(na)), np.empty(search_ints(na), dtype=np.int64)
+
+
+@jit
+def _deepest_admissible(W, q, mu_s, mode, sign, p0, Pz, velocity_tol, scale, p_out, w_scale, floats, ints):
     """admissible_split once the mode's equations are solved: the split p0 + Pz z deepest inside
-    every cone (no simplex when Pz has no column), checked against the law."""
-    z = np.zeros(Pz.shape[1])
-    G, h, weight = _admissible_constraints(W, q, mode, sign, mu_s, p0, Pz, velocity_tol, scale)
-    margin = _deepest_split(G, h, weight, z)
+    every cone (no simplex when Pz has no column), checked against the law. w_scale: max |W|, or
+    1e-300 (the search's, computed once). Its temporaries are carved from (floats, ints)
+    (search_scratch, or buffers of its own when they are too small)."""
+    m2, k, na = W.shape[0], Pz.shape[1], mode.shape[0]
+    if floats.shape[0] < _admissible_floats(na, k) or ints.shape[0] < simplex_ints(4 * na + 2 * k + 1, 2 * k + 2):
+        floats = np.empty(_admissible_floats(na, k))
+        ints = np.empty(simplex_ints(4 * na + 2 * k + 1, 2 * k + 2), dtype=np.int64)
+    u0, at = carve(floats, 0, m2)
+    u, at = carve(floats, at, m2)
+    Wz, at = carve_matrix(floats, at, m2, k)
+    G, at = carve_matrix(floats, at, 4 * na, k)
+    h, at = carve(floats, at, 4 * na)
+    weight, at = carve(floats, at, 4 * na)
+    z, at = carve(floats, at, k)
+    _matrix_vector(W, p0, q, u0)  # u0 = W p0 + q
+    if k > 0:
+        np.dot(W, Pz, Wz)
+    n = _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_tol, scale, G, h, weight)
+    margin = _deepest_split(G[:n], h[:n], weight[:n], z, floats[at:], ints)
     if margin < -MARGIN_TOL:
         return False
-    p_out[:] = p0 + Pz @ z
-    u = W @ p_out + q
+    if k == 0:  # the split is p0 itself, and u = W p0 + q is u0 (bit for bit: p0 + 0 is p0)
+        for i in range(m2):
+            p_out[i] = p0[i] + 0.0
+        return _split_obeys_law(W, q, mode, sign, mu_s, p_out, u0, velocity_tol, scale)
+    np.dot(Pz, z, u0)
+    for i in range(m2):
+        p_out[i] = p0[i] + u0[i]
+    _matrix_vector(W, p_out, q, u)
     return _split_obeys_law(W, q, mode, sign, mu_s, p_out, u, velocity_tol, scale)
+
+
+@jit
+def _matrix_vector(A, x, b, out):
+    """out = A x + b (A x by BLAS, as `A @ x + b`), allocating nothing."""
+    np.dot(A, x, out)
+    for i in range(out.shape[0]):
+        out[i] += b[i]
+
+
+@jit
+def _max_abs(A):
+    """max |A_ij| (np.max(np.abs(A)) without the temporary)."""
+    largest = 0.0
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            largest = max(largest, abs(A[i, j]))
+    return largest
 
 
 @jit
@@ -574,24 +718,23 @@ def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p
     scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / w_max)
     if scale <= 0.0:
         return False
-    mode = np.zeros(na, dtype=np.int64)
-    sign = np.zeros(na)
-    p_new = np.zeros(2 * na)
-    q_held = np.empty(2 * na)
+    mode, sign, p_new, q_held = np.zeros(na, dtype=np.int64), np.zeros(na), np.zeros(2 * na), np.empty(2 * na)
+    floats, ints = search_scratch(na)  # every LP's temporaries, carved
     n_c = min(n_c, 62)  # a bit mask of the candidates
     if _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
-                 scale, p_start, p_new):
+                 scale, p_start, p_new, floats, ints):
         _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
         return True
     if n_c == 1:  # the one candidate cannot be held: the only other set, none, is the solver's own
         return False
-    kept = _prune(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
-                  scale, p_new)
+    relaxed = _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign, floats, ints)
+    kept = _prune(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
+                  velocity_tol, scale, p_new, floats, ints)
     if _sticking_mask(candidates, kept, states) == (1 << kept) - 1:
         return False  # no moving candidate can be held: every held set is within the solver's own
     n_c = min(kept, MAX_CANDIDATES)
-    held = held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
-                    velocity_tol, scale, p_new)
+    held = held_set(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
+                    velocity_tol, scale, p_new, floats, ints)
     if held < 0 or held == _sticking_mask(candidates, n_c, states):
         return False  # nothing admissible, or the solver's own mode (its velocities are the mode's)
     _write_solution(W, q, mode, p_new, velocity_tol, p, u, states)
@@ -600,7 +743,7 @@ def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p
 
 @jit
 def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
-              scale, p_start, p_new):
+              scale, p_start, p_new, floats, ints):
     """Is every candidate held admissible (then the one largest set: the common step of a body at
     rest)? The previous step's split p_start, when it still holds them to round-off, is the answer
     without an LP. Fills mode, sign and p_new."""
@@ -609,42 +752,44 @@ def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, st
                                                                REUSE_TOL * velocity_tol, scale):
         p_new[:] = p_start
         return True
-    return _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+    return _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats, ints)
 
 
 @jit
-def _prune(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol, scale,
-           p_new):
+def _prune(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
+           scale, p_new, floats, ints):
     """Keep (moved to the front of candidates, release) the candidates that can be held with the
     other candidates free, and return how many: one the solver holds needs no test (its answer is
-    a split of the relaxation); each other costs one LP."""
+    a split of the relaxation, `relaxed`: _relaxed_base); each other costs one LP."""
     kept = 0
-    relaxed = _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign)
+    no_trials = _no_trials()
     for c in range(n_c):
         _modes_for(1 << c, candidates, release, n_c, u, states, mode, sign, True)
         added = np.array([2 * candidates[c] + 1]) if release[c] != 0.0 else \
             np.array([2 * candidates[c], 2 * candidates[c] + 1])
-        if states[candidates[c]] == STATE_STICK or _pruning_either(
-                relaxed, added, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+        if states[candidates[c]] == STATE_STICK or _shared_either(
+                relaxed, added, no_trials, -1, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale,
+                p_new, floats, ints):
             candidates[kept], release[kept] = candidates[c], release[c]
             kept += 1
     return kept
 
 
 @jit
-def _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign):
+def _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign, floats, ints):
     """What the pruning LPs of one search share (issue 26: each was a QR of the whole group). The
     relaxation with every candidate free (MODE_FREE, MODE_LOOSE) has the unknowns of every pruning
     LP — holding candidate c only adds its rows u_T = 0 (and u_N = 0 for one that lifts) — so its
     equations A_f x = b_f are factored once: the solutions of a pruning LP's are x_f + Z_f w with
     R_c Z_f w = b_c − R_c x_f, R_c the added rows (1 or 2). Returns (certain, P, rows, W P, Q₁,
-    R₁₁⁻ᵀ, Z_f, σ, ‖A_f‖²_F) — certain False when A_f's full row rank is not vouched for."""
+    R₁₁⁻ᵀ, Z_f, σ, ‖A_f‖²_F, max |W|, floats, ints) — certain False when A_f's full row rank is
+    not vouched for; (floats, ints): the search's scratch (search_scratch), which its LPs carve."""
     _modes_for(0, candidates, release, n_c, u, states, mode, sign, True)
     P, rows = _unknowns(mode, sign, mu_d)
     WP = W @ P
     A = np.ascontiguousarray(WP[rows, :])
     certain, Q1, R_inv_T, Z, sigma_min = _full_row_rank_parts(A)
-    return certain, P, rows, WP, Q1, R_inv_T, Z, sigma_min, np.sum(A ** 2)
+    return certain, P, rows, WP, Q1, R_inv_T, Z, sigma_min, np.sum(A ** 2), max(1e-300, _max_abs(W)), floats, ints
 
 
 @jit
@@ -656,7 +801,7 @@ def _pruning_split(relaxed, added, W, q, mu_s, mode, sign, velocity_tol, scale, 
     A_f's rows and R_c's), so ‖A_c‖_F over that bound below 1/RANK_TOL means the SVD would find
     A_c of full row rank too: both ways then have the same solutions x0 + Z z of the mode's
     equations (Z = Z_f N orthonormal, N spanning M's null space) and the same deepest margin."""
-    certain, P, rows, WP, Q1, R_inv_T, Z_f, sigma_f, a_f2 = relaxed
+    certain, P, rows, WP, Q1, R_inv_T, Z_f, sigma_f, a_f2, w_scale, floats, ints = relaxed
     if not certain:
         return -1
     b_f = np.empty(rows.shape[0])
@@ -674,25 +819,33 @@ def _pruning_split(relaxed, added, W, q, mu_s, mode, sign, velocity_tol, scale, 
     x0 = x_f + Z_f @ (Q1_m @ (R_inv_T_m @ r_c))
     Z = np.ascontiguousarray(Z_f @ N)
     return 1 if _deepest_admissible(W, q, mu_s, mode, sign, P @ x0, np.ascontiguousarray(P @ Z), velocity_tol,
-                                    scale, p_out) else 0
+                                    scale, p_out, w_scale, floats, ints) else 0
 
 
 @jit
-def _pruning_either(relaxed, added, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-    """_admissible_either of a pruning LP, on the shared relaxation where it is vouched for
-    (_pruning_split), else the general way."""
-    found = _pruning_split(relaxed, added, W, q, mu_s, mode, sign, velocity_tol, scale, p_new)
-    if found < 0:
-        found = 1 if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new) else 0
-    if found == 1:
-        return True
-    if np.max(closing) <= 0.0:
-        return False
-    _without_gap_closing(q, closing, mode, q_held)
-    found = _pruning_split(relaxed, added, W, q_held, mu_s, mode, sign, velocity_tol, scale, p_new)
-    if found < 0:
-        return admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
-    return found == 1
+def _shared_either(relaxed, added, trials, held, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale,
+                   p_new, floats, ints):
+    """admissible_split of one LP of the search (mode and sign its own) through the factorization
+    its search shares where that is vouched for, else the general way: a pruning LP (held < 0: the
+    candidate whose rows are `added`, on the relaxation, _pruning_split) or a held-set trial (held:
+    the mask of the held candidates, on the bordered base, _bordered_split). When the step's q
+    admits no split, the same for q without its gap-closing part (_admissible_either's rule)."""
+    for attempt in range(2):
+        if attempt == 1:
+            if np.max(closing) <= 0.0:
+                return False
+            _without_gap_closing(q, closing, mode, q_held)
+        rhs = q if attempt == 0 else q_held
+        if held < 0:
+            found = _pruning_split(relaxed, added, W, rhs, mu_s, mode, sign, velocity_tol, scale, p_new)
+        else:
+            found = _bordered_split(trials, held, W, rhs, mu_s, mode, sign, velocity_tol, scale, p_new)
+        if found < 0:
+            found = 1 if admissible_split_in(W, rhs, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats,
+                                             ints) else 0
+        if found == 1:
+            return True
+    return False
 
 
 @jit
@@ -706,8 +859,8 @@ def _sticking_mask(candidates, n_c, states):
 
 
 @jit
-def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
-             scale, p_new):
+def held_set(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
+             velocity_tol, scale, p_new, floats, ints):
     """The held set of prefer_sticking as a bit mask over the candidates (mode, sign and p_new
     filled for it), or −1 when none is admissible or the trials run out. Largest first; a size
     with one admissible set returns it; a size with several restricts the search to the subsets of
@@ -718,7 +871,8 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
     allowed = (1 << n_c) - 1
     trials = 0
     p_found = np.empty_like(p_new)
-    shared = _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign)
+    shared = _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign, floats, ints)
+    added = np.zeros(0, dtype=np.int64)
     while True:
         found, n_found, common = -1, 0, allowed
         for size in range(_popcount(allowed), -1, -1):
@@ -731,8 +885,8 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
                     return -1
                 trials += 1
                 _modes_for(held, candidates, release, n_c, u, states, mode, sign, False)
-                if _trial_either(shared, held, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale,
-                                 p_new):
+                if _shared_either(relaxed, added, shared, held, W, q, q_held, closing, mu_s, mu_d, mode, sign,
+                                  velocity_tol, scale, p_new, floats, ints):
                     found, n_found, common = held, n_found + 1, common & held
                     p_found[:] = p_new
             if n_found > 0:
@@ -747,29 +901,31 @@ def held_set(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, sta
 
 
 @jit
-def _small_inverse(S):
-    """Inverse of the small square S by Gauss–Jordan with partial pivoting; infinities when a pivot
-    is zero (they fail the certificate of _bordered_split)."""
-    s = S.shape[0]
-    M = np.zeros((s, 2 * s))
-    M[:, :s] = S
+def _small_inverse(S, s, LU, rows, inverse):
+    """inverse = S⁻¹ of the leading s × s block of S (the package's LU, kernel_base.lu_factor: in
+    LU and rows, scratch), allocating nothing; infinities when a pivot is zero (they fail the
+    certificate of _bordered_split)."""
     for i in range(s):
-        M[i, s + i] = 1.0
-    for col in range(s):
-        r = col
-        for i in range(col + 1, s):
-            if abs(M[i, col]) > abs(M[r, col]):
-                r = i
-        if not M[r, col] != 0.0:
-            return np.full((s, s), np.inf)
-        for k in range(2 * s):
-            M[col, k], M[r, k] = M[r, k], M[col, k]
-        M[col, :] /= M[col, col]
-        for i in range(s):
-            factor = M[i, col]
-            if i != col and factor != 0.0:
-                M[i, :] -= factor * M[col, :]
-    return np.ascontiguousarray(M[:, s:])
+        for j in range(s):
+            LU[i, j] = S[i, j]
+    if not lu_factor(LU, s, rows, 0.0):
+        inverse[:, :] = np.inf
+        return
+    for j in range(s):
+        column = inverse[j]  # row j of the inverse's transpose: the solution for the jth unit vector
+        column[:] = 0.0
+        column[j] = 1.0
+        lu_solve(LU, s, rows, column)
+    for i in range(s):  # transpose in place
+        for j in range(i + 1, s):
+            inverse[i, j], inverse[j, i] = inverse[j, i], inverse[i, j]
+
+
+@jit
+def _no_trials():
+    """A _bordered_trials tuple that vouches for no trial (the pruning LPs' placeholder)."""
+    empty, none = np.zeros((0, 0)), np.zeros(0, dtype=np.int64)
+    return (False, empty, none, none, none, empty, empty, empty, empty, empty, empty, np.zeros(4), np.zeros(0), none)
 
 
 @jit
@@ -782,7 +938,7 @@ def _inverse_by_qr(A):
 
 
 @jit
-def _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign):
+def _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign, floats, ints):
     """What every held-set trial of one search shares, factored once (issue 26: the row of 16's
     trials were each a fresh QR of the whole mode, 80 % of their cost). The base is the mode with
     every candidate released; holding candidate c adds to it the unknown p_T of c (p_T = −μd s p_N
@@ -791,8 +947,9 @@ def _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign):
     p and a row's of u — the same indices). So with A0 the base's square matrix, B its columns in the
     added directions, C the added rows and D their block, the trial solves through the Schur
     complement S = D − C A0⁻¹ B restricted to its entries (at most 2 × 16). Returns the tuple
-    _bordered_split reads; its first entry False when the base is not square (a base with freedom
-    in its split: every trial goes the general way)."""
+    _bordered_split reads, the search's scratch (floats, ints: search_scratch) last; its first entry
+    False when the base is not square (a base with freedom in its split: every trial goes the
+    general way)."""
     _modes_for(0, candidates, release, n_c, u, states, mode, sign, False)
     P0, rows0 = _unknowns(mode, sign, mu_d)
     n_ext = 0
@@ -828,27 +985,30 @@ def _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign):
         norms[2, e], norms[3, e] = np.sum(Y[:, e] ** 2), np.sum(X[e, :] ** 2)
     ok = n0 > 0 and rows0.shape[0] == n0 and np.all(np.isfinite(A0_inv))
     return (ok, P0, rows0, ext, owner, A0_inv, Y, C, D - C @ Y, D, norms,
-            np.array([np.sum(A0 ** 2), _frobenius(A0_inv), 1.5 * (1.0 + np.max(mu_d) ** 2)]))
+            np.array([np.sum(A0 ** 2), _frobenius(A0_inv), 1.5 * (1.0 + np.max(mu_d) ** 2), max(1e-300, _max_abs(W))]),
+            floats, ints)
 
 
 @jit
-def _bordered_solve(trials, chosen, S_inv, rhs, p_out):
+def _bordered_solve(trials, chosen, S_inv, minus_rhs, p_out, b0, y, r_e, delta, Py):
     """p_out += the solution of the trial's equations (rows of u = W p + q: base rows and `chosen`
-    added entries) for the right-hand side rhs (an entry per row of u): y = A0⁻¹ b0,
-    δ = S⁻¹ (b_e − C y), x = y − A0⁻¹B δ; p = P0 x + Σ δ_e at the added entries."""
-    ok, P0, rows0, ext, owner, A0_inv, Y, C, S_all, D, norms, scalars = trials
-    b0 = np.empty(rows0.shape[0])
+    added entries) for the right-hand side −minus_rhs (an entry per row of u): y = A0⁻¹ b0,
+    δ = S⁻¹ (b_e − C y), x = y − A0⁻¹B δ; p = P0 x + Σ δ_e at the added entries. b0, y, r_e,
+    delta, Py: scratch (the base's rows, its unknowns, the chosen entries twice, p's length)."""
+    P0, rows0, ext, A0_inv, Y, C = trials[1], trials[2], trials[3], trials[5], trials[6], trials[7]
     for r in range(rows0.shape[0]):
-        b0[r] = rhs[rows0[r]]
-    y = A0_inv @ b0
+        b0[r] = -minus_rhs[rows0[r]]
+    np.dot(A0_inv, b0, y)
     s = chosen.shape[0]
-    r_e = np.empty(s)
     for a in range(s):
-        r_e[a] = rhs[ext[chosen[a]]] - np.dot(C[chosen[a], :], y)
-    delta = S_inv @ r_e
+        r_e[a] = -minus_rhs[ext[chosen[a]]] - np.dot(C[chosen[a], :], y)
+    np.dot(S_inv, r_e, delta)
     for a in range(s):
-        y -= delta[a] * Y[:, chosen[a]]
-    p_out += P0 @ y
+        for i in range(y.shape[0]):
+            y[i] -= delta[a] * Y[i, chosen[a]]
+    np.dot(P0, y, Py)
+    for i in range(Py.shape[0]):
+        p_out[i] += Py[i]
     for a in range(s):
         p_out[ext[chosen[a]]] += delta[a]
 
@@ -862,55 +1022,62 @@ def _bordered_split(trials, held, W, q, mu_s, mode, sign, velocity_tol, scale, p
     X = C A0⁻¹), times the change of basis from (p_N, p_T) to (p_N, δ) stays below 1/RANK_TOL: K
     then has full rank at the SVD's threshold in admissible_split's unknowns too, so the mode fixes
     the split and both ways find the same unique one, to round-off (one step of iterative
-    refinement on the residual of its equations)."""
-    ok, P0, rows0, ext, owner, A0_inv, Y, C, S_all, D, norms, scalars = trials
+    refinement on the residual of its equations). Its temporaries come from the search's scratch."""
+    ok, P0, rows0, ext, owner, A0_inv, Y, C, S_all, D, norms, scalars, floats, ints = trials
     if not ok:
         return -1
-    chosen = np.flatnonzero((held >> owner) & 1)
-    S_inv = _small_inverse(np.ascontiguousarray(S_all[chosen][:, chosen]))
+    m2, n0 = q.shape[0], A0_inv.shape[0]
+    chosen_all, at_int = carve(ints, 0, BORDER_MAX)
+    rows, at_int = carve(ints, at_int, BORDER_MAX)
+    s = 0
+    for e in range(owner.shape[0]):
+        if (held >> owner[e]) & 1:
+            chosen_all[s] = e
+            s += 1
+    chosen = chosen_all[:s]
+    S, at = carve_matrix(floats, 0, s, s)
+    LU, at = carve_matrix(floats, at, s, s)
+    S_inv, at = carve_matrix(floats, at, s, s)
+    r_e, at = carve(floats, at, s)
+    delta, at = carve(floats, at, s)
+    b0, at = carve(floats, at, n0)
+    y, at = carve(floats, at, n0)
+    p0, at = carve(floats, at, m2)
+    residual, at = carve(floats, at, m2)
+    work, at = carve(floats, at, m2)
+    no_z, at = carve_matrix(floats, at, m2, 0)  # Pz of a mode that fixes the split: no column
     k2, y2, x2 = scalars[0], 0.0, 0.0
-    for e in chosen:
-        k2 += norms[0, e] + norms[1, e] + np.sum(D[e, chosen] ** 2)
+    for a in range(s):
+        e = chosen[a]
+        block = 0.0
+        for b in range(s):
+            S[a, b] = S_all[e, chosen[b]]
+            block += D[e, chosen[b]] ** 2
+        k2 += norms[0, e] + norms[1, e] + block
         y2, x2 = y2 + norms[2, e], x2 + norms[3, e]
+    _small_inverse(S, s, LU, rows, S_inv)
     s_f = _frobenius(S_inv)
     inv_bound = scalars[1] + s_f * (np.sqrt(y2 * x2) + np.sqrt(y2) + np.sqrt(x2) + 1.0)
     if not (np.sqrt(k2) * inv_bound * scalars[2] < 1.0 / RANK_TOL):
         return -1
-    p0 = np.zeros(q.shape[0])
-    _bordered_solve(trials, chosen, S_inv, -q, p0)
-    _bordered_solve(trials, chosen, S_inv, -(W @ p0 + q), p0)  # refinement: the residual's correction
-    return 1 if _deepest_admissible(W, q, mu_s, mode, sign, p0, np.zeros((q.shape[0], 0)), velocity_tol, scale,
-                                    p_out) else 0
+    p0[:] = 0.0
+    _bordered_solve(trials, chosen, S_inv, q, p0, b0, y, r_e, delta, work)
+    _matrix_vector(W, p0, q, residual)  # refinement: the residual's correction
+    _bordered_solve(trials, chosen, S_inv, residual, p0, b0, y, r_e, delta, work)
+    return 1 if _deepest_admissible(W, q, mu_s, mode, sign, p0, no_z, velocity_tol, scale, p_out, scalars[3],
+                                    floats[at:], ints) else 0
 
 
 @jit
-def _trial_either(trials, held, W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
-    """_admissible_either of a held-set trial, through the shared factorization where it is
-    certified (_bordered_split), else the general way."""
-    found = _bordered_split(trials, held, W, q, mu_s, mode, sign, velocity_tol, scale, p_new)
-    if found < 0:
-        found = 1 if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new) else 0
-    if found == 1:
-        return True
-    if np.max(closing) <= 0.0:
-        return False
-    _without_gap_closing(q, closing, mode, q_held)
-    found = _bordered_split(trials, held, W, q_held, mu_s, mode, sign, velocity_tol, scale, p_new)
-    if found < 0:
-        return admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
-    return found == 1
-
-
-@jit
-def _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+def _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats, ints):
     """admissible_split of the mode for the step's q, or else (a held body need not chase gaps of
     position round-off) for q without its gap-closing part."""
-    if admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new):
+    if admissible_split_in(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats, ints):
         return True
     if np.max(closing) <= 0.0:
         return False
     _without_gap_closing(q, closing, mode, q_held)
-    return admissible_split(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new)
+    return admissible_split_in(W, q_held, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats, ints)
 
 
 @jit
