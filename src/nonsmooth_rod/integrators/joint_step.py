@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ..model.joints import ROWS_PER_JOINT, joint_rows, jointed_dofs
 from ..model.packing import CI_BODY_A
 from ..solvers.two_coefficient import STATE_OPEN, STATE_STICK
@@ -162,7 +162,7 @@ def constrained_delassus(na, active, hn, ht, index, minv, slot, WC, W):
             W[2 * a + 1, 2 * b + 1] = _constrained_product(ht[i], index, i, ht[j], j, minv, slot, WC)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def held_contact_rows(na, active, states, touching, hn, ht, index, slot, rows, bodies):
     """The contact rows the position projection must not move (rows, bodies filled; returns their
     count): of the contacts closed this step on a jointed body — loaded, or `touching` (active,
@@ -185,7 +185,7 @@ def held_contact_rows(na, active, states, touching, hn, ht, index, slot, rows, b
     return m
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _projection_system(q, table, J, C, held, held_bodies, n_held, G, target):
     """G = [J(q); the held contact rows], target = [C(q); 0]; returns max |C|."""
     joint_rows(table, q, J, C)
@@ -206,7 +206,7 @@ def _projection_system(q, table, J, C, held, held_bodies, n_held, G, target):
     return violation
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def project_positions(q, minv, table, J, C, held, held_bodies, n_held):
     """Newton's iteration in the mass metric, q ← q − M⁻¹GᵀA⁺[C(q); 0] with G = [J; held contact
     rows] and A = G M⁻¹ Gᵀ: the joints' violation goes back to round-off of the coordinates (or

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ._common import RESIDUAL_FLOOR, make_solution
 from ..validation import InputError
 from .kernel_base import (
@@ -159,7 +159,7 @@ def _solve_mode(W, q, lo, hi, modes, rcond, A, b, G, h):
     return P
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def solve_mode_table(W, q, lo, hi, table, rcond):
     """`_solve_mode` for every row of ``table`` (mode combinations): P, shape (K, 2 n_c)."""
     n = q.shape[0]
@@ -173,7 +173,7 @@ def solve_mode_table(W, q, lo, hi, table, rcond):
     return P
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def enum_candidates(W, q, lo, hi, table, rcond):
     """(P, U, residuals, scales) of every mode combination's solution.
 
@@ -206,7 +206,7 @@ def _mode_row(k, n_contacts):
     return modes
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def enum_table(n_contacts):
     """All 4^n_c mode combinations as rows (same order as `_mode_table`)."""
     table = np.zeros((4**n_contacts, n_contacts), dtype=np.int64)
@@ -242,7 +242,7 @@ def choose_candidate(residuals, scales, P, rtol):
     return chosen, n_valid
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def enum_interval(W, q, lo, hi, p, u, rtol, max_contacts):
     """The enumeration kernel: fills p, u; returns (status, combinations, residual).
 

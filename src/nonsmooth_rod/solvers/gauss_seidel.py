@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit, jit_borrowing
+from .._jit import jit, jit_borrowing, jit_inline
 from ._common import make_solution, require_finite_array
 from ..validation import InputError
 from .kernel_base import (
@@ -235,7 +235,7 @@ def pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, f
     return KERNEL_NO_CONVERGENCE, limit, residual
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _mode_solution(A, b):
     """lstsq's minimum-norm least-squares solution of A x = b. A square A (every mode of a row of
     balls) whose QR certifies it well conditioned — ‖R‖_F ‖R⁻¹‖_F < 1/RANK_TOL bounds σ_max/σ_min,
@@ -261,7 +261,7 @@ def _certified_square_solution(A, b):
     return True, np.ascontiguousarray(Q) @ (np.ascontiguousarray(R_inv.T) @ b)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def solve_mode(W, q, lo, hi, p, u):
     """Replace p, u (one group, dense W) by the exact solution of the mode p shows: a contact with
     p_N > 0 touches (u_N = 0) and sticks (u_T = 0) if p_T is strictly inside its interval, else

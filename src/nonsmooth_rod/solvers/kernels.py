@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit, jit_borrowing
+from .._jit import jit, jit_borrowing, jit_inline
 from .enumeration import enum_interval
 from .delassus import dense_to_blocks
 from .gauss_seidel import pgs_block, pgs_block_into, pgs_dense, pgs_dense_into
@@ -114,7 +114,7 @@ def _screened(status):
     return status, 0, (np.inf if status == KERNEL_NONFINITE else 0.0)
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     """lemke_interval behind the common screen, in the scratch (floats, ints: at least
     kernel_base.solver_scratch of these contacts — the counting callers' fitting_scratch).
@@ -125,7 +125,7 @@ def solve_lemke_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     return lemke_interval(W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def solve_pgs_into(W, q, lo, hi, p, u, rtol, max_iter, floats, ints):
     """pgs_dense_into behind the common screen, in the scratch (floats, ints: kernel_base.solver_scratch
     of these contacts holds it). Borrowing (the step's dense pgs: a step with joints)."""

@@ -51,7 +51,7 @@ import time
 import numpy as np
 
 from .._jit import ENABLED as HAVE_NUMBA
-from .._jit import jit, jit_borrowing
+from .._jit import jit, jit_borrowing, jit_inline
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
 from .kernel_base import carve, carve_matrix, lu_factor, lu_solve, problem_scale, solver_scratch, step_residual
@@ -182,7 +182,7 @@ def _prefer_z0(T, r, z0_row, entering, rhs, pivot_tol):
     return r
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _complementary_pivoting(T, basis, n, max_pivots):
     """Lemke's method on tableau T = [I | −M | −d | q]; basis[i] is the variable of row i.
 
@@ -204,7 +204,7 @@ def _complementary_pivoting(T, basis, n, max_pivots):
     return _resume_pivoting(T, basis, n, leaving + n, 1, max_pivots)
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _resume_pivoting(T, basis, n, entering, pivots, max_pivots):
     """The pivoting loop from `entering` (the complement of the variable that left last), after
     `pivots` pivots, up to max_pivots in all: (status, pivots, entering)."""
@@ -278,7 +278,7 @@ def _basic_solution(T, basis, M, q, n, z, residual):
             z[v - n] = max(x, 0.0)
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _lemke_kernel(M, q, max_pivots, T, basis, z, residual):
     """Lemke on (M, q) given as rows/vector, in the caller's scratch (T: n × (2n + 2), basis,
     z, residual: n); fills z, returns (status, pivots, last entering)."""

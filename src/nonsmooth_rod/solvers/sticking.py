@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from .delassus import coupled_components, group_matrix
 from .kernel_base import carve, carve_matrix, lu_factor, lu_solve
 from .problem import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK
@@ -265,7 +265,7 @@ def _upper_inverse(R):
     return inv
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _full_row_rank_solution(A, b):
     """x0 and Z of _particular_and_null without the SVD, when A (m × n, m ≤ n) certainly has full row
     rank at RANK_TOL: (True, x0, Z), else (False, ·, ·) and the caller takes the SVD.
@@ -305,7 +305,7 @@ def _full_row_rank_parts(A):
             1.0 / inverse_norm)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _particular_and_null(A, b):
     """Least-squares x0 of A x = b (minimum norm) and an orthonormal basis Z of the null space of A
     (_full_row_rank_solution when it can vouch for A's rank, else the SVD)."""
@@ -328,7 +328,7 @@ def _particular_and_null(A, b):
     return x0, Z
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_tol, scale, G, h, weight):
     """Rows (G, h, weight) of  g0 + g·z ≥ weight·t  for every law the split must keep, in
     impulse units divided by `scale`: p_N ≥ t and μs p_N ∓ p_T ≥ t (weight 1, the margins);
@@ -392,7 +392,7 @@ def _fixed_split_margin(h, weight):
     return t
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _deepest_split(G, h, weight, z, floats, ints):
     """max t subject to g0 + g·z ≥ weight·t, |z| ≤ SPLIT_BOUND, t ≤ 1 (z, t free; scaled units).
     Fills z and returns t (−inf when even the hard rows cannot hold). The LP's tableau is written
@@ -741,7 +741,7 @@ def prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p
     return True
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
               scale, p_start, p_new, floats, ints):
     """Is every candidate held admissible (then the one largest set: the common step of a body at
@@ -755,7 +755,7 @@ def _all_held(W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, st
     return _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats, ints)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _prune(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign, velocity_tol,
            scale, p_new, floats, ints):
     """Keep (moved to the front of candidates, release) the candidates that can be held with the
@@ -775,7 +775,7 @@ def _prune(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c,
     return kept
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign, floats, ints):
     """What the pruning LPs of one search share (issue 26: each was a QR of the whole group). The
     relaxation with every candidate free (MODE_FREE, MODE_LOOSE) has the unknowns of every pruning
@@ -792,7 +792,7 @@ def _relaxed_base(W, mu_d, candidates, release, n_c, u, states, mode, sign, floa
     return certain, P, rows, WP, Q1, R_inv_T, Z, sigma_min, np.sum(A ** 2), max(1e-300, _max_abs(W)), floats, ints
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _pruning_split(relaxed, added, W, q, mu_s, mode, sign, velocity_tol, scale, p_out):
     """admissible_split of a pruning LP (mode and sign its own: one candidate held, the others
     free) on the shared relaxation: 1 admissible, 0 not, −1 not vouched for (the caller takes
@@ -858,7 +858,7 @@ def _sticking_mask(candidates, n_c, states):
     return mask
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def held_set(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_c, u, states, mode, sign,
              velocity_tol, scale, p_new, floats, ints):
     """The held set of prefer_sticking as a bit mask over the candidates (mode, sign and p_new
@@ -921,14 +921,14 @@ def _small_inverse(S, s, LU, rows, inverse):
             inverse[i, j], inverse[j, i] = inverse[j, i], inverse[i, j]
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _no_trials():
     """A _bordered_trials tuple that vouches for no trial (the pruning LPs' placeholder)."""
     empty, none = np.zeros((0, 0)), np.zeros(0, dtype=np.int64)
     return (False, empty, none, none, none, empty, empty, empty, empty, empty, empty, np.zeros(4), np.zeros(0), none)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _inverse_by_qr(A):
     """A⁻¹ = R⁻¹ Qᵀ (LAPACK's QR, which never fails; infinities for a zero pivot of R)."""
     if A.shape[0] == 0:
@@ -937,7 +937,7 @@ def _inverse_by_qr(A):
     return _upper_inverse(R) @ np.ascontiguousarray(Q.T)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _bordered_trials(W, mu_d, candidates, release, n_c, u, states, mode, sign, floats, ints):
     """What every held-set trial of one search shares, factored once (issue 26: the row of 16's
     trials were each a fresh QR of the whole mode, 80 % of their cost). The base is the mode with
@@ -1013,7 +1013,7 @@ def _bordered_solve(trials, chosen, S_inv, minus_rhs, p_out, b0, y, r_e, delta, 
         p_out[ext[chosen[a]]] += delta[a]
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _bordered_split(trials, held, W, q, mu_s, mode, sign, velocity_tol, scale, p_out):
     """admissible_split of the trial holding the candidates in `held` (mode and sign already its
     own) through the shared factorization: 1 admissible, 0 not, −1 not certified (the caller
@@ -1068,7 +1068,7 @@ def _bordered_split(trials, held, W, q, mu_s, mode, sign, velocity_tol, scale, p
                                     floats[at:], ints) else 0
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def _admissible_either(W, q, q_held, closing, mu_s, mu_d, mode, sign, velocity_tol, scale, p_new, floats, ints):
     """admissible_split of the mode for the step's q, or else (a held body need not chase gaps of
     position round-off) for q without its gap-closing part."""
@@ -1102,7 +1102,7 @@ def scatter_contacts(members, p_group, u_group, states_group, p, u, states):
         states[i] = states_group[a]
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its callees' code again
 def prefer_sticking_by_group(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u,
                              states, max_group, p_start):
     """prefer_sticking on each group of coupled contacts alone (coupled_components). The step's
