@@ -333,6 +333,12 @@ class Hybrid(EventDriven):
                                         lambda stage: None)
         return None if hit is None else (float(hit[0]), indicators[hit[1]].kind, indicators[hit[1]].contact)
 
+    def solves_compiled(self, scene, t: float, q, v, modes) -> bool:
+        """Whether `modes` at (t, q, v) are solved by the compiled mode solve (not mode_dynamics,
+        ~10 times slower a step: a statically indeterminate stick, a singular A)."""
+        system = self._system(scene, modes)
+        return system.usable and system.evaluate(t, np.concatenate([q, v])) is not None
+
     def _step(self, mode: _Mode, start: _Stage, h: float, run):
         """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""
         c, a, b, mid = TABLEAUX[self.options.order]
