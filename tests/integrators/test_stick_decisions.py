@@ -102,3 +102,17 @@ def test_scenes_the_hybrid_method_does_not_run_are_left_to_the_step():
     assert not decisions._predicts() and decisions.predictions == 0
     decisions = _decisions(RodProblem.paper().scene())
     assert decisions._predicts() and decisions.table[0, C_MU_S] > decisions.table[0, C_MU_D]
+
+
+def test_stop_condition_during_a_hold_ends_on_the_held_trajectory():
+    """A stop condition that holds while the rod is held through its T/N peak (δ = +1e-6, the
+    step's break-away at 0.153 s taken back): the run ends at its first kept sample where it
+    holds, on the very trajectory of the run without the condition, still sticking."""
+    problem = RodProblem.paper(None, mu_s=_peak() + 1e-6, mu_d=0.2)
+    scene = problem.scene()
+    q0, v0 = problem.initial_state()
+    full = nr.simulate(scene, q0, v0, 0.37, "moreau-jean", h=H)
+    stopped = nr.simulate(scene, q0, v0, 0.37, "moreau-jean", h=H, stop=lambda t, q, v: t >= 0.2)
+    assert stopped.status == "stopped" and stopped.t[-1] == pytest.approx(0.2, abs=H / 2)
+    assert np.array_equal(stopped.q, full.q[: len(stopped.q)])
+    assert [p.mode for p in stopped.phases["A"]] == ["stick"]

@@ -450,8 +450,9 @@ class MoreauJean:
             w[...] = saved
         window.out[9][:] = snapshot[1]
         window.r = k - window.k_base
-        with held:
-            self._advance(engine, scene, window, k_to - k, *arrays)
+        if k_to > k:
+            with held:
+                self._advance(engine, scene, window, k_to - k, *arrays)
         return k_to
 
     @staticmethod
