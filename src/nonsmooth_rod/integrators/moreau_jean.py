@@ -762,11 +762,12 @@ def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_st
         for before, after in zip(found, found[1:]):
             k = int(round((after.t_start - grid.origin) / h))
             t_k = grid.origin + k * h
+            by_prediction = before.mode == "stick" and after.mode in SLIP_MODES and (i, k) in predicted
             if before.mode == "open":
                 t_switch = min((t for (c, step), t in impact_time.items() if c == contact.name and abs(step - k) <= 1),
                                key=lambda t: abs(t - t_k), default=t_k)
                 kind = "impact"
-            elif (i, k) in predicted:
+            elif by_prediction:
                 t_switch, kind = predicted[(i, k)], "stick-slip"
             else:
                 def slip_velocity(j, contact=contact):  # with the Jacobian at q_j itself
@@ -785,7 +786,7 @@ def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_st
             if kind != "impact" and t_switch >= t_first:
                 events.append(Event(float(t_switch), kind, contact.name,
                                     {"from": before.mode, "to": after.mode, "step": k,
-                                     "located": "predicted" if (i, k) in predicted else "interpolated"}))
+                                     "located": "predicted" if by_prediction else "interpolated"}))
         phases[contact.name] = _from(found, t_first)
     return phases, events
 

@@ -102,8 +102,9 @@ class StickDecisions:
         self.held: dict[int, tuple[int, int]] = {}  # contact → (first step held, first step not held)
         self.released: dict[int, tuple[int, int]] = {}  # contact → (first step released, first not)
         self.acted: set[int] = set()  # the first steps of the mode runs acted on
-        # (contact, step) → the predicted time of the break-away it is released at in that step:
-        # its phase boundary (moreau_jean.located_phases), not one extrapolated from the held steps
+        # (contact, step) → the predicted time of a confirmed break-away whose slide may start in
+        # that step: its phase boundary (moreau_jean.located_phases), not one extrapolated from the
+        # step's ratios (held, or overshooting)
         self.switches: dict[tuple[int, int], float] = {}
         self.predictions = 0
         self._ahead: dict = {}  # a mode run's first step → its prediction (each contact's break-away reads it)
