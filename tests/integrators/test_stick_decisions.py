@@ -116,3 +116,21 @@ def test_stop_condition_during_a_hold_ends_on_the_held_trajectory():
     assert stopped.status == "stopped" and stopped.t[-1] == pytest.approx(0.2, abs=H / 2)
     assert np.array_equal(stopped.q, full.q[: len(stopped.q)])
     assert [p.mode for p in stopped.phases["A"]] == ["stick"]
+
+
+def test_a_scenes_later_runs_reuse_its_predictor_with_the_same_decisions():
+    """The predicting Hybrid (its compiled mode solves set up) is given back to the scene's plan
+    after a prediction and taken by the next run, which decides the same (the same trajectory and
+    predicted boundary)."""
+    from nonsmooth_rod.integrators.scene_plans import scene_plan
+
+    problem = RodProblem.paper(None, mu_s=_peak() + 1e-6, mu_d=0.2)
+    scene, (q0, v0) = problem.scene(), problem.initial_state()
+    first = nr.simulate(scene, q0, v0, 0.3, "moreau-jean", h=H)
+    plan = scene_plan(scene)
+    assert plan.predicted is True and len(plan.predictors) == 1
+    kept = plan.predictors[0]
+    again = nr.simulate(scene, q0, v0, 0.3, "moreau-jean", h=H)
+    assert plan.predictors == [kept] and again.stats["stick_predictions"] == first.stats["stick_predictions"] >= 1
+    assert np.array_equal(first.q, again.q) and np.array_equal(first.v, again.v)
+    assert [e.t for e in first.events] == [e.t for e in again.events]

@@ -44,6 +44,7 @@ holds are not carried over).
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 from dataclasses import dataclass
 
@@ -69,6 +70,7 @@ PREDICTED_CONTACTS = ("DiskOnLine",)
 RELEASE_STEPS = 2
 SLIDING = (STATE_SLIP_PLUS, STATE_SLIP_MINUS)
 NOT_PREDICTED = "not predicted"  # a mode run the compiled mode solve declines: the step's law decides
+MAX_PREDICTORS = 2  # predicting Hybrids a scene's plan keeps (threads running the scene at once)
 
 
 @dataclass(frozen=True)
@@ -82,21 +84,24 @@ class _ModeRun:
     codes: np.ndarray
 
 
-def stick_decisions(scene, model, grid):
+def stick_decisions(scene, model, grid, plan=None):
     """The run's StickDecisions, or None where the hybrid method does not run the scene's contacts
-    (its other refusals, joints and driven things, are checked at the first prediction)."""
+    (its other refusals, joints and driven things, are checked at the first prediction, and kept
+    in the scene's plan for its later runs: integrators/scene_plans.py)."""
     if not scene.contacts or any(type(c).__name__ not in PREDICTED_CONTACTS for c in scene.contacts):
         return None
-    return StickDecisions(scene, model.contacts, grid)
+    if plan is not None and plan.predicted is False:
+        return None
+    return StickDecisions(scene, model.contacts, grid, plan)
 
 
 class StickDecisions:
     """The holds and releases a fixed-step run's chunks of steps run in, and the review of each
     chunk's break-aways that plans them."""
 
-    def __init__(self, scene, table, grid):
-        self.scene, self.table, self.grid = scene, table, grid
-        self.smooth = self.hybrid = None  # adaptive_breakaway and the predicting Hybrid: at the first prediction
+    def __init__(self, scene, table, grid, plan=None):
+        self.scene, self.table, self.grid, self.plan = scene, table, grid, plan
+        self.smooth = None  # adaptive_breakaway: at the first prediction
         self.handled = True  # until the first prediction finds a refusal of the hybrid method
         self.run_start: _ModeRun | None = None
         self.held: dict[int, tuple[int, int]] = {}  # contact → (first step held, first step not held)
@@ -187,11 +192,13 @@ class StickDecisions:
 
     def _predicts(self) -> bool:
         """Whether the hybrid method runs the scene (set up at the first call: 0.2 s of imports)."""
-        if self.hybrid is None and self.handled:
+        if self.smooth is None and self.handled:
             from . import adaptive_breakaway
-            from .hybrid import Hybrid, HybridOptions, handles
-            self.handled = handles(self.scene)
-            self.smooth, self.hybrid = adaptive_breakaway, Hybrid(HybridOptions(h=adaptive_breakaway.PREDICTION_STEP))
+            from .hybrid import handles
+            self.handled = handles(self.scene) if self.plan is None or self.plan.predicted is None else True
+            if self.plan is not None:
+                self.plan.predicted = self.handled
+            self.smooth = adaptive_breakaway
         return self.handled
 
     def _prediction(self, start: _ModeRun):
@@ -202,17 +209,41 @@ class StickDecisions:
         if start.k not in self._ahead:
             modes = [STATE_NAMES[int(c)] for c in start.codes]
             v = self.smooth.consistent_velocity(self.scene, start.q, start.v, modes)
-            if self.hybrid.solves_compiled(self.scene, start.t, start.q, v, modes):
-                self.predictions += 1
-                self._ahead[start.k] = self.hybrid.first_event(self.scene, start.t, start.q, v, modes,
-                                                               self.grid.t_end)
-            else:
-                self._ahead[start.k] = NOT_PREDICTED
+            hybrid = self._predictor()
+            try:
+                if hybrid.solves_compiled(self.scene, start.t, start.q, v, modes):
+                    self.predictions += 1
+                    self._ahead[start.k] = hybrid.first_event(self.scene, start.t, start.q, v, modes, self.grid.t_end)
+                else:
+                    self._ahead[start.k] = NOT_PREDICTED
+            finally:
+                # (not one holding many mode solves: a frictionless contact's margin, part of their
+                # key, changes from state to state)
+                if self.plan is not None and len(self.plan.predictors) < MAX_PREDICTORS and len(hybrid._systems) <= 64:
+                    self.plan.predictors.append(hybrid)
         return self._ahead[start.k]
+
+    def _predictor(self):
+        """A predicting Hybrid: one an earlier prediction of the scene gave back to its plan (its
+        compiled mode solves set up: a third of a prediction), or a new one. (list.pop: two
+        threads running the scene never share one.)"""
+        try:
+            return self.plan.predictors.pop()
+        except (AttributeError, IndexError):  # no plan, or none given back
+            from .hybrid import Hybrid
+            return Hybrid(_prediction_options())
 
     def _step_holding(self, t: float) -> int:
         """The step whose interval [t_k, t_k+1) holds t (at most the grid's last)."""
         return min(int(math.floor((t - self.grid.origin) / self.grid.h)), self.grid.last)
+
+
+@functools.cache
+def _prediction_options():
+    """The predicting Hybrid's options (made once: checking them costs more than a prediction)."""
+    from . import adaptive_breakaway
+    from .hybrid import HybridOptions
+    return HybridOptions(h=adaptive_breakaway.PREDICTION_STEP)
 
 
 def _during(plan: dict, k: int) -> tuple:
