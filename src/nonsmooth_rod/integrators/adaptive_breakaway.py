@@ -197,7 +197,10 @@ def consistent_velocity(scene, q, v, modes) -> np.ndarray:
     if not rows:
         return v
     H = np.array(rows)
-    return v - _projection(scene.inverse_mass_diagonal, H, H @ v - np.array(targets))
+    residual = H @ v - np.array(targets)
+    if not residual.any():  # consistent already (a run's exact start): its projection is zero
+        return v
+    return v - _projection(scene.inverse_mass_diagonal, H, residual)
 
 
 class Held:

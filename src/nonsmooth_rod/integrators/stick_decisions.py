@@ -133,14 +133,21 @@ class StickDecisions:
         lo = max(r0 - 1, 0)
         if self.run_start is None:
             self._start(window, lo, window.full(5, lo))
+        if not self.handled:
+            return None
         columns = window.out[5][lo:r1]  # the contacts' columns (contacts never near: no column, open)
-        if not self.handled or not np.any(columns[1:] != columns[:-1]):
+        rows = np.any(columns[1:] != columns[:-1], axis=1)  # (a row changes where its contacts' codes do)
+        if not rows.any():
             return None  # (most chunks: no mode changes)
         codes, p_normal = window.full(5, slice(lo, r1)), window.full(2, slice(lo, r1))
-        changed = np.flatnonzero(np.any(codes[1:] != codes[:-1], axis=1)) + 1
-        for c in changed.tolist():
-            broke = (codes[c - 1] == STATE_STICK) & (p_normal[c - 1] > 0.0) & np.isin(codes[c], SLIDING)
-            for i in np.flatnonzero(broke).tolist():
+        changed = np.flatnonzero(rows) + 1
+        # each change's loaded contacts sticking before it and sliding after, at once (per change,
+        # the few rows' numpy calls cost more than the comparisons)
+        after = codes[changed]
+        broke = ((codes[changed - 1] == STATE_STICK) & (p_normal[changed - 1] > 0.0)
+                 & ((after == SLIDING[0]) | (after == SLIDING[1])))
+        for c, contacts in zip(changed.tolist(), broke.tolist()):
+            for i in (i for i, b in enumerate(contacts) if b):
                 back = self._confirm(i, window.k_base + lo + c, k)
                 if back is not None:
                     return back
