@@ -12,7 +12,8 @@ what the step's own discretisation adds (the Jacobian of the step's start); the 
 error of the state itself, first order (the rolling rod loses ~5 % · h/s of its energy to the
 projections of the steps), which no decision on the step's state can remove.
 
-Phases (full run only): μs = max T/N ± δ, δ = 1e-3 … 1e-6, at h = 1e-3, with tol = 1e-4 and
+Phases (full run only): μs = max T/N ± δ, δ = 1e-3 … 1e-6, at h = 1e-3 (its break-aways confirmed
+by the smooth phase, integrators/stick_decisions.py: docs/friction.md), with tol = 1e-4 and
 1e-5, and with the hybrid method (Runge–Kutta of order 4 in each mode) at h = 1e-3 and 1e-2,
 against the event-driven reference: right phase sequence, largest boundary error.
 Writes DIR/grazing_overshoot.csv (and DIR/grazing_phases.csv) and prints markdown tables.

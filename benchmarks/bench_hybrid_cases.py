@@ -3,8 +3,8 @@ adaptive.py, `tol=`) on 25 rods with (μs, μd) drawn over 0.05–0.6 (μd ≤ �
 event-driven reference at rtol 1e-12: the phase sequence of ball A, the largest phase boundary
 error and ball B's impact error, the work and the cost, for each h (hybrid) and each tol.
 
-    python benchmarks/bench_hybrid_cases.py [--h 1e-2 5e-2] [--tol 1e-5 1e-6] [--cases 0 1 ...]
-                                            [--window H] [--positions] [--quick] [--out DIR]
+    python benchmarks/bench_hybrid_cases.py [--h 1e-2 5e-2] [--tol 1e-5 1e-6] [--fixed-h 1e-3]
+                                            [--cases 0 1 ...] [--window H] [--positions] [--quick] [--out DIR]
 
 Prints a markdown table (docs/error_control.md quotes it), one row per run; with --out, also
 DIR/hybrid_cases.csv, one row per case and run. Work: steps (hybrid) or step evaluations (tol,
@@ -14,7 +14,8 @@ the cases, in yardsticks measured in the same run (benchmarks/yardstick.py). --q
 and tol = 1e-6 (a test runs it). --window: the tol runs' first and largest window (default 1e-2 s).
 --positions: for each tol run and case, also the largest |q − q_ref| (x_O, y_O, θ together) over
 0–0.1, 0.1–0.2, 0.2–0.3 s and 0.3 s to ball B's impact, at the run's accepted times, against the
-reference's samples every 1e-4 s (cubic Hermite in q, v). Exits 1 if a
+reference's samples every 1e-4 s (cubic Hermite in q, v). --fixed-h: Moreau–Jean at these fixed
+steps (its stick decisions by the smooth phase, integrators/stick_decisions.py). Exits 1 if a
 phase sequence is wrong, or if a tol run has a boundary or the impact off by more than 10 tol.
 """
 from __future__ import annotations
@@ -62,12 +63,14 @@ def position_errors(run, reference) -> list[float]:
 
 
 def compare(mu_s: float, mu_d: float, reference, run_name: str, value: float, window: float | None = None) -> dict:
-    """One run ("hybrid" with h = value, or "tol": Moreau–Jean with tol = value, largest window
-    `window`) against the reference."""
+    """One run ("hybrid" with h = value, "fixed": Moreau–Jean with h = value, or "tol": Moreau–Jean
+    with tol = value, largest window `window`) against the reference."""
     problem = RodProblem.paper(None, mu_s=mu_s, mu_d=mu_d)
     started = time.process_time()
-    run = (simulate(problem, "hybrid", h=value) if run_name == "hybrid"
-           else simulate(problem, "moreau-jean", tol=value, **({"h": window} if window else {})))
+    if run_name == "tol":
+        run = simulate(problem, "moreau-jean", tol=value, **({"h": window} if window else {}))
+    else:
+        run = simulate(problem, "hybrid" if run_name == "hybrid" else "moreau-jean", h=value)
     cpu = time.process_time() - started
     got, expected = [p.mode for p in run.phases], [p.mode for p in reference.phases]
     ok = got == expected
@@ -81,7 +84,7 @@ def compare(mu_s: float, mu_d: float, reference, run_name: str, value: float, wi
 
 def row(rows: list[dict], yardstick: float) -> str:
     r0 = rows[0]
-    knob = f"hybrid h = {r0['value']:g}" if r0["run"] == "hybrid" else f"Moreau–Jean tol = {r0['value']:g}"
+    knob = {"hybrid": "hybrid h", "fixed": "Moreau–Jean h", "tol": "Moreau–Jean tol"}[r0["run"]] + f" = {r0['value']:g}"
     wrong = [r["case"] for r in rows if not r["ok"]]
     return (f"| {knob} | {len(rows) - len(wrong)}/{len(rows)}" + (f" (wrong: {wrong})" if wrong else "") +
             f" | {max(r['boundary_error_s'] for r in rows):.1e} | {np.nanmax([r['impact_error_s'] for r in rows]):.1e}"
@@ -112,6 +115,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--h", type=float, nargs="*", default=None, help="hybrid steps (default 1e-2 5e-2)")
     parser.add_argument("--tol", type=float, nargs="*", default=[], help="Moreau–Jean tolerances")
+    parser.add_argument("--fixed-h", type=float, nargs="*", default=[], help="Moreau–Jean fixed steps")
     parser.add_argument("--cases", type=int, nargs="+", default=None, help="case indices (default all 25)")
     parser.add_argument("--window", type=float, default=None, help="tol runs' largest window (s)")
     parser.add_argument("--positions", action="store_true", help="tol runs' position errors by span")
@@ -124,10 +128,10 @@ def main(argv=None) -> int:
     all_cases = cases()
     references = {i: simulate(RodProblem.paper(None, mu_s=all_cases[i][0], mu_d=all_cases[i][1]), "event-driven",
                               output_dt=1e-4 if args.positions else 1e-3) for i in chosen}
-    if tols:
+    if tols or args.fixed_h:
         simulate(RodProblem.paper(), "moreau-jean", tol=1e-2)  # warm: compile or load the loop once
     simulate(RodProblem.paper(), "hybrid")  # warm: its kernels and imports
-    runs = [("hybrid", h) for h in steps] + [("tol", t) for t in tols]
+    runs = [("hybrid", h) for h in steps] + [("tol", t) for t in tols] + [("fixed", h) for h in args.fixed_h]
     table = []
     for name, value in runs:
         table.append([dict(compare(*all_cases[i], references[i], name, value, args.window), case=i) for i in chosen])

@@ -61,7 +61,9 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     impact), a callable (t, q, v) -> bool (tried at each kept sample while the run goes: it
     ends at the first where one is true, status "stopped"), or a list of these.
     resume: the `end_state` of an earlier Moreau–Jean result (what its next step reads: contact
-    memory, warm starts, the step grid): the run goes on exactly as the earlier one would have;
+    memory, warm starts, the step grid): the run goes on exactly as the earlier one would have
+    (but for a break-away confirmed by the smooth phase in a stick that spans the resume: it is
+    predicted from the resumed run's first state, not the stick's start, docs/friction.md);
     `result.restart(t_end)` passes it.
     Bad input raises InputError naming the argument; a run that fails returns a result with
     status "failed" and a message saying where and why.

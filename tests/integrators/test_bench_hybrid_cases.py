@@ -42,3 +42,15 @@ def test_positions_by_span_against_the_reference(capsys):
     spans, boundary, impact = cells[:len(bench.SPANS)], cells[len(bench.SPANS)], cells[len(bench.SPANS) + 1]
     assert len(spans) == 4 and all(0.0 < e <= 1e-5 for e in spans), spans
     assert boundary <= 1e-5 and impact <= 1e-5
+
+
+def test_fixed_step_row_has_the_references_phases(tmp_path, capsys):
+    """--fixed-h: Moreau–Jean at h = 1e-3, its break-aways confirmed by the smooth phase
+    (integrators/stick_decisions.py), on case 0 (stick 0.30 s, then slip+): the reference's
+    phases, its break-away at the predicted time and ball B's impact within a step."""
+    bench = _bench()
+    assert bench.main(["--h", "--fixed-h", "1e-3", "--cases", "0", "--out", str(tmp_path)]) == 0
+    row = next(csv.DictReader((tmp_path / "hybrid_cases.csv").open()))
+    assert row["run"] == "fixed" and row["phases"] == row["reference_phases"] == "stick slip+"
+    assert float(row["boundary_error_s"]) <= 1e-3 and float(row["impact_error_s"]) <= 1e-3
+    assert "| Moreau–Jean h = 0.001 | 1/1 |" in capsys.readouterr().out

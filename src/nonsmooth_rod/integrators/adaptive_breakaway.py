@@ -143,7 +143,7 @@ class BreakAways:
         """A context in which the window's held contacts' μs is raised in the packed table and its
         released ones' lowered to μd (restored after: the table may be shared by the runs of a
         scene, integrators/scene_plans.py)."""
-        return _Held(self.contacts, window.held, window.released)
+        return Held(self.contacts, window.held, window.released)
 
     def _loaded(self, point) -> tuple[tuple, tuple]:
         """The contacts loaded in the step reaching the point, and those of them that stick (none
@@ -197,10 +197,16 @@ def consistent_velocity(scene, q, v, modes) -> np.ndarray:
     if not rows:
         return v
     H = np.array(rows)
-    return v - _projection(scene.inverse_mass_diagonal, H, H @ v - np.array(targets))
+    residual = H @ v - np.array(targets)
+    if not residual.any():  # consistent already (a run's exact start): its projection is zero
+        return v
+    return v - _projection(scene.inverse_mass_diagonal, H, residual)
 
 
-class _Held:
+class Held:
+    """The packed table with a window's held contacts' friction raised and its released ones' μs lowered
+    to μd, restored on leaving (the table may be shared by the runs of a scene)."""
+
     def __init__(self, table, held: tuple, released: tuple):
         self.table, self.held, self.released = table, list(held), list(released)
 

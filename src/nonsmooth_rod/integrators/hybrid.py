@@ -15,7 +15,9 @@ end and its midpoint stage (the state y + h/2 k of the stage at t + h/2, the for
 solved for anyway) — and only a sign change, or a dip between them (a parabola through the
 three with an interior minimum at most half the smaller end value: a grazing peak of T/N inside
 the step), is looked at closely on the step's cubic Hermite interpolant (brentq, or a bounded
-minimisation then brentq). Events are located to the interpolant's accuracy, O(h⁴).
+minimisation then brentq). Events are located to the interpolant's accuracy, O(h⁴). A prediction
+(`first_event`) runs its steps and the watch's tests on them in one compiled call up to the first
+step the watch must look at closely (watch_screen.py): the same event, from the same numbers.
 
 Every mode solve — the stages, the watch's values, the reference's mode decisions, rest test and
 samples (`_dynamics`) — runs through model/dynamics.ModeSystem, mode_dynamics' equations set up
@@ -35,6 +37,7 @@ from ..solvers import available_solvers
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
 from .sampling import thinned_count
+from .watch_screen import screened_steps_into
 from .event_driven import (_EPS, _TINY, EventDriven, _first_of, _force_scale, _indicator_values, _indicators,
                            _Watch)
 
@@ -55,6 +58,9 @@ DIP_FRACTION = 0.5
 # A segment's first step is at most GROWTH times the segment before it, each next one GROWTH
 # times the one before (up to h): steps follow the time scale of accumulating events.
 GROWTH = 2.0
+# A prediction's steps (Hybrid.first_event) are laid out this many at a time for the compiled
+# watch (watch_screen), which stops at the first step it flags: the rod's stick (~0.1 s at 1e-2) in one.
+BLOCK = 16
 # Halvings of a step's first interval looking for the side an indicator starting at zero leaves to.
 MAX_HALVINGS = 60
 
@@ -329,9 +335,65 @@ class Hybrid(EventDriven):
         indicators = _indicators(scene, modes, 1e-9 * _force_scale(scene, t, q, v))
         mode = _Mode(scene, modes, indicators, self._system)
         start = _Stage(mode, t, np.concatenate([q, v]))
-        hit, _, _ = self._watched_steps(mode, start, _StepWatch(mode, start), t_end, math.inf, _Counts(),
-                                        lambda stage: None)
+        hit = self._screened_steps(mode, start, _StepWatch(mode, start), t_end)
         return None if hit is None else (float(hit[0]), indicators[hit[1]].kind, indicators[hit[1]].contact)
+
+    def _screened_steps(self, mode: _Mode, start: _Stage, watch: _StepWatch, t_end: float):
+        """_watched_steps' event (t, indicator index) or None from `start` (no first-step cap), its
+        steps and the watch's tests in one compiled call up to the first step the tests flag
+        (watch_screen), which the watch itself looks at, with its bands as they were there: the
+        same event from the same numbers. Step by step (_watched_steps) from a step the compiled
+        mode solve declines, or where the mode has no compiled solve."""
+        system, (c, a, b, mid) = mode.system, TABLEAUX[self.options.order]
+        a_array, b_array = TABLEAU_ARRAYS[self.options.order]
+        s_start = watch.values(start)
+        while system is not None and system.usable and system.constant:
+            tb, steps = self._step_times(start.t, t_end, BLOCK)
+            if not steps:  # (a start at t_end: the step's own way)
+                break
+            states, outs = np.empty((len(steps), len(c) + 1, start.y.shape[0])), np.empty((len(steps), len(c) + 1,
+                                                                                            system.out.shape[0]))
+            m = screened_steps_into(system.table, system.ints, system.watched, system.offsets, system.minv, system.free,
+                                    start.y, np.array(steps), np.array(tb), a_array, b_array, mid, float(c[mid]),
+                                    float(watch.t0), watch.sign, watch.noise, watch.band_exit, s_start, DIP_FRACTION,
+                                    states, outs)
+            done = len(steps) if m == len(steps) else m if m >= 0 else -1 - m  # steps passed
+            if done:
+                start = _Stage(mode, tb[done], states[done - 1, -1], outs[done - 1, -1])
+                s_start = watch.sign * start.values
+            if m == len(steps) and start.t >= t_end:
+                return None
+            if m < 0:
+                break
+            if m < len(steps):
+                end = _Stage(mode, tb[m + 1], states[m, -1], outs[m, -1])
+                s_end = watch.sign * end.values
+                watch.evaluations += 2
+                hit = watch.first_event_sampled(_hermite(start, end), (tb[m], tb[m] + c[mid] * steps[m], tb[m + 1]),
+                                                np.array([s_start, watch.sign * outs[m, mid, system.values], s_end]))
+                if hit is not None or end.t >= t_end:
+                    return hit
+                start, s_start = end, s_end
+        hit, _, _ = self._watched_steps(mode, start, watch, t_end, math.inf, _Counts(), lambda stage: None)
+        return hit
+
+    def _step_times(self, t: float, t_end: float, n: int):
+        """Up to n steps' boundaries from t (t first) and lengths, as _watched_steps takes them
+        (no first-step cap): to t_end at most, no sliver of a last step."""
+        tb, steps, h = [t], [], self.options.h
+        while len(steps) < n and tb[-1] < t_end:
+            step = min(h, t_end - tb[-1])
+            if t_end - tb[-1] < 1.01 * step:
+                step = t_end - tb[-1]
+            steps.append(step)
+            tb.append(tb[-1] + step)
+        return tb, steps
+
+    def solves_compiled(self, scene, t: float, q, v, modes) -> bool:
+        """Whether `modes` at (t, q, v) are solved by the compiled mode solve (not mode_dynamics,
+        ~10 times slower a step: a statically indeterminate stick, a singular A)."""
+        system = self._system(scene, modes)
+        return system.usable and system.evaluate(t, np.concatenate([q, v])) is not None
 
     def _step(self, mode: _Mode, start: _Stage, h: float, run):
         """One Runge–Kutta step of h from `start`: (its midpoint stage, its end)."""

@@ -45,6 +45,7 @@ from .joint_step import work_size
 from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .scene_plans import scene_plan
+from .stick_decisions import stick_decisions
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
                                  ResumeState, Window, kept_steps)
 
@@ -303,6 +304,11 @@ class Engine:
         return _jit.compiling(self.part, self.what, prepare=compile_callees if self.part == LOOP_PART else None)
 
 
+# The endings of a chunk of steps whose break-aways are reviewed (stick_decisions): every step
+# of it done (a stop at an impact included: a break-away before it may move the impact)
+REVIEWED = (loop.RUN_OK, loop.RUN_STOPPED)
+
+
 class MoreauJean:
     """The Moreau–Jean one-step integrator over a Scene (one loop: moreau_jean_loop)."""
 
@@ -310,6 +316,7 @@ class MoreauJean:
 
     def __init__(self, options: MoreauJeanOptions | None = None):
         self.options = options or MoreauJeanOptions()
+        self._predicted_switches = {}  # the last run's break-aways at predicted times (stick_decisions)
 
     SAMPLES_KNOB = "a larger h, a coarser save_every or a shorter t_end"  # what keeps fewer samples (the driver's memory refusal says it)
 
@@ -349,12 +356,15 @@ class MoreauJean:
         engine = Engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
         self._solver_error = None
         wall = time.process_time()
+        decisions = stick_decisions(scene, model, grid, plan)
         with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
-            ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop))
+            ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop),
+                                   decisions)
         cpu = time.process_time() - wall
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": engine.compiled and solver_code is not None,
-                 "force_callback": self._calls_back}
+                 "force_callback": self._calls_back, "stick_predictions": decisions.predictions if decisions else 0}
+        self._predicted_switches = decisions.switches if decisions else {}
         result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
         # lent to the next run of the scene, which first has the result copy its end state out of
         # them if it is still alive (a loop that drops each result never copies); a window too
@@ -413,8 +423,10 @@ class MoreauJean:
                             int(opts.repeat_rest and not varies_in_time)], dtype=np.int64)
         return params, iparams
 
-    def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops):
-        """Run the grid's steps window by window; returns (run status, global step the run ended at)."""
+    def _windows(self, engine, scene, grid, window, collector, params, iparams, model, work, stops, decisions):
+        """Run the grid's steps window by window, each chunk of steps in the holds and releases
+        `decisions` plans (integrators/stick_decisions.py; None: the step's law alone) and its
+        break-aways reviewed by them; returns (run status, global step the run ended at)."""
         k = grid.first
         if stops and stop_holds(stops, grid.time(k), window.out[0][window.r], window.out[1][window.r]):
             collector.take(window, k, k, final=True)
@@ -424,20 +436,23 @@ class MoreauJean:
                 window.slide()
             last = bool(grid.h_last) and k == grid.last - 1
             n = engine.steps(1 if last else min(window.room(), grid.first + grid.n_full - k))
+            n = n if decisions is None else decisions.steps(k, n)
             step_params = self._shortened(params, grid, window, k) if last else params
             params[loop.P_K0] = window.k_base
-            snapshot = ([w.copy() for w in work], window.out[9].copy()) if stops else None
+            snapshot = ([w.copy() for w in work], window.out[9].copy()) if stops or decisions else None
+            held = contextlib.nullcontext() if decisions is None else decisions.holding(k)
             started = time.perf_counter()
-            status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
+            with held:
+                status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
             engine.measured(k_done - k, time.perf_counter() - started, grid.last - k_done, status)
+            k_back = decisions.review(window, k, k_done) if decisions and status in REVIEWED else None
+            if k_back is not None:  # its steps from k_back on are run again, as the review planned
+                k_done = self._replay(engine, scene, window, snapshot, k, k_back, (step_params, iparams, model, work), held)
+                status = loop.RUN_OK
             k_hold = self._first_hold(stops, collector, window, k, k_done) if stops else None
             if k_hold is not None:
                 if k_hold < k_done:  # replay to the step where it holds: the end state is that step's
-                    for w, saved in zip(work, snapshot[0]):
-                        w[...] = saved
-                    window.out[9][:] = snapshot[1]
-                    window.r = k - window.k_base
-                    self._advance(engine, scene, window, k_hold - k, step_params, iparams, model, work)
+                    self._replay(engine, scene, window, snapshot, k, k_hold, (step_params, iparams, model, work), held)
                 collector.take(window, k, k_hold, final=True)
                 return loop.RUN_STOPPED_BY_CONDITION, k_hold
             final = status != loop.RUN_OK or k_done == grid.last
@@ -446,6 +461,19 @@ class MoreauJean:
             if status != loop.RUN_OK:
                 return status, k
         return loop.RUN_OK, k
+
+    def _replay(self, engine, scene, window, snapshot, k, k_to, arrays, held) -> int:
+        """The chunk's steps from k run again to k_to, from the work memory and counters of
+        `snapshot` (taken at k), in the context `held` it ran in; returns k_to."""
+        work = arrays[3]
+        for w, saved in zip(work, snapshot[0]):
+            w[...] = saved
+        window.out[9][:] = snapshot[1]
+        window.r = k - window.k_base
+        if k_to > k:
+            with held:
+                self._advance(engine, scene, window, k_to - k, *arrays)
+        return k_to
 
     @staticmethod
     def _shortened(params, grid, window, k):
@@ -603,11 +631,12 @@ class MoreauJean:
         t_stop = None
         if run_status == loop.RUN_STOPPED:
             t_stop = max(i.t for i in impacts if i.contact == self.options.stop_at_impact)
-        min_phase = self.options.min_phase
+        min_phase, predicted = self.options.min_phase, self._predicted_switches
 
         def locate(result):  # on first use of result.phases or result.events
             collector.settle_rows()
-            phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop)
+            phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop,
+                                                  predicted)
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
         n_done, counts = k_end - grid.first, counters.tolist()
@@ -739,10 +768,13 @@ def _contact_phases(runs, grid, k_end, t_final, min_phase):
     return phases_from_intervals(bounds, [STATE_NAMES[c] for _, c in runs], min_phase)
 
 
-def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_stop):
+def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_stop, predicted=None):
     """Per-contact phases with each boundary placed inside its step (interpolating the slip
     velocity, the friction ratio or the normal impulse between steps; an impact's boundary at the
-    impact time), and one event per boundary; from the run's start t_first on."""
+    impact time; a break-away the smooth phase decided at its predicted time, `predicted`:
+    (contact, step) → t, stick_decisions), and one event per boundary; from the run's start
+    t_first on."""
+    predicted = predicted or {}
     phases, events = {}, []
     if k_end <= grid.first:
         return phases, events
@@ -754,10 +786,13 @@ def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_st
         for before, after in zip(found, found[1:]):
             k = int(round((after.t_start - grid.origin) / h))
             t_k = grid.origin + k * h
+            by_prediction = before.mode == "stick" and after.mode in SLIP_MODES and (i, k) in predicted
             if before.mode == "open":
                 t_switch = min((t for (c, step), t in impact_time.items() if c == contact.name and abs(step - k) <= 1),
                                key=lambda t: abs(t - t_k), default=t_k)
                 kind = "impact"
+            elif by_prediction:
+                t_switch, kind = predicted[(i, k)], "stick-slip"
             else:
                 def slip_velocity(j, contact=contact):  # with the Jacobian at q_j itself
                     qv = records.qv(j)
@@ -774,7 +809,8 @@ def located_phases(scene, records, packed, impacts, grid, k_end, min_phase, t_st
             before.t_end = after.t_start = float(t_switch)
             if kind != "impact" and t_switch >= t_first:
                 events.append(Event(float(t_switch), kind, contact.name,
-                                    {"from": before.mode, "to": after.mode, "step": k, "located": "interpolated"}))
+                                    {"from": before.mode, "to": after.mode, "step": k,
+                                     "located": "predicted" if by_prediction else "interpolated"}))
         phases[contact.name] = _from(found, t_first)
     return phases, events
 

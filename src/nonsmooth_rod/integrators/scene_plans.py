@@ -49,7 +49,7 @@ class ScenePlan:
     lent to one run at a time (`borrow`, `give_back`)."""
 
     __slots__ = ("packed", "joints", "names", "varies_in_time", "python_motions", "static", "model", "_spares",
-                 "_owners", "parameters")
+                 "_owners", "parameters", "predicted", "predictors")
 
     def __init__(self, scene):
         self.packed = pack_scene(scene)
@@ -63,6 +63,9 @@ class ScenePlan:
         self._spares: dict = {}  # key → [(arrays, the buffers they are carved from, their result's weakref)]
         self._owners: dict = {}  # id(arrays) → (arrays, their buffers, their bytes)
         self.parameters = None  # (options, t0, t_end, grid, params, iparams, slip default) of the last run (moreau_jean._run_parameters)
+        self.predicted = None  # whether the hybrid method runs the scene (stick_decisions), at its first prediction
+        # the stick decisions' predicting Hybrids (their compiled mode solves set up), one to a run at a time
+        self.predictors: list = []
 
     def borrow(self, key):
         """A set of arrays lent under `key` by an earlier run, zeroed, or None (none lent, or other
