@@ -122,14 +122,14 @@ class Stepper:
     def run(self, point: Point, h: float, n: int):
         """n steps of h from point; returns (status, out)."""
         out, work, params = self.out(n), self.work, self.params
-        out[0][1], out[1][1] = point.q, point.v
+        out.q[1], out.v[1] = point.q, point.v
         for j, rec in enumerate(point.records):
             out[2 + j][0] = rec
         for slot, saved in zip(MEMORY, point.memory):
             work[slot][:] = saved
         params[loop.P_H] = params[loop.P_H_GRID] = h
         params[loop.P_T0], params[loop.P_K0] = point.t, -1.0
-        counters = out[9]
+        counters = out.counters
         counters[loop.K_N_IMPACTS], counters[loop.K_DONE] = 0, 1
         started = time.perf_counter()
         kernels = self.engine.kernels
@@ -155,28 +155,28 @@ class Stepper:
 
     def _attempt(self, point: Point, H: float, n: int) -> Attempt:
         status, out = self.run(point, H / n, n)
-        q_c, v_c, states_c = out[0][n + 1].copy(), out[1][n + 1].copy(), out[5][1: n + 1].copy()
-        n_imp_c = int(out[9][loop.K_N_IMPACTS])
+        q_c, v_c, states_c = out.q[n + 1].copy(), out.v[n + 1].copy(), out.states[1: n + 1].copy()
+        n_imp_c = int(out.counters[loop.K_N_IMPACTS])
         if status != loop.RUN_OK:
             return Attempt(status, q_c, v_c, q_c, v_c, None, None, None, None, [], n_imp_c)
         m = 2 * n
         status, out = self.run(point, H / m, m)
         impacts = []
-        rows = [int(out[7][j]) for j in range(int(out[9][loop.K_N_IMPACTS]))]
+        rows = [int(out.impact_step[j]) for j in range(int(out.counters[loop.K_N_IMPACTS]))]
         for j, row in enumerate(rows):
-            t_row, t_hit = point.t + (row - 1) * H / m, float(out[6][j])
-            impacts.append((int(out[8][j]), t_hit, t_row, out[0][row].copy(), out[1][row].copy(),
-                            out[1][row + 1].copy(), out[2][row].copy(), out[3][row].copy(),
-                            *_at_impact(out[1], row, m, set(rows), (t_hit - t_row) / (H / m))))
-        states = np.vstack([states_c, out[5][1: m + 1]])
+            t_row, t_hit = point.t + (row - 1) * H / m, float(out.impact_t[j])
+            impacts.append((int(out.impact_contact[j]), t_hit, t_row, out.q[row].copy(), out.v[row].copy(),
+                            out.v[row + 1].copy(), out.p_normal[row].copy(), out.p_tangent[row].copy(),
+                            *_at_impact(out.v, row, m, set(rows), (t_hit - t_row) / (H / m))))
+        states = np.vstack([states_c, out.states[1: m + 1]])
         records = tuple(out[2 + j][m].copy() for j in range(4))
-        impulses = (out[2][1: m + 1].sum(axis=0), out[3][1: m + 1].sum(axis=0))
+        impulses = (out.p_normal[1: m + 1].sum(axis=0), out.p_tangent[1: m + 1].sum(axis=0))
         memory = tuple(self.work[slot].copy() for slot in MEMORY)
-        fine = np.vstack([point.records[3][None, :], out[5][1: m + 1]])
+        fine = np.vstack([point.records[3][None, :], out.states[1: m + 1]])
         switches = {}
         for j, i in zip(*np.nonzero(fine[1:] != fine[:-1])):
             switches.setdefault(int(i), point.t + j * H / m)
-        return Attempt(status, q_c, v_c, out[0][m + 1].copy(), out[1][m + 1].copy(), states, records, impulses,
+        return Attempt(status, q_c, v_c, out.q[m + 1].copy(), out.v[m + 1].copy(), states, records, impulses,
                        memory, impacts, n_imp_c, switches)
 
 

@@ -428,7 +428,7 @@ class MoreauJean:
         `decisions` plans (integrators/stick_decisions.py; None: the step's law alone) and its
         break-aways reviewed by them; returns (run status, global step the run ended at)."""
         k = grid.first
-        if stops and stop_holds(stops, grid.time(k), window.out[0][window.r], window.out[1][window.r]):
+        if stops and stop_holds(stops, grid.time(k), window.out.q[window.r], window.out.v[window.r]):
             collector.take(window, k, k, final=True)
             return loop.RUN_STOPPED_BY_CONDITION, k
         while k < grid.last:
@@ -439,7 +439,7 @@ class MoreauJean:
             n = n if decisions is None else decisions.steps(k, n)
             step_params = self._shortened(params, grid, window, k) if last else params
             params[loop.P_K0] = window.k_base
-            snapshot = ([w.copy() for w in work], window.out[9].copy()) if stops or decisions else None
+            snapshot = ([w.copy() for w in work], window.out.counters.copy()) if stops or decisions else None
             held = contextlib.nullcontext() if decisions is None else decisions.holding(k)
             started = time.perf_counter()
             with held:
@@ -468,7 +468,7 @@ class MoreauJean:
         work = arrays[3]
         for w, saved in zip(work, snapshot[0]):
             w[...] = saved
-        window.out[9][:] = snapshot[1]
+        window.out.counters[:] = snapshot[1]
         window.r = k - window.k_base
         if k_to > k:
             with held:
@@ -487,7 +487,7 @@ class MoreauJean:
         interpreted twins), the window's records widened whenever a new candidate finds their
         columns taken; returns (run status, global step reached)."""
         r0 = r = window.r
-        window.out[9][loop.K_DONE] = r0
+        window.out.counters[loop.K_DONE] = r0
         kernels = engine.kernels
         with engine.compiling():
             while True:
@@ -499,8 +499,8 @@ class MoreauJean:
                 if status != loop.RUN_RECORDS_SHORT:
                     break
                 window.widen()  # and step K_DONE again, from its start
-                r = int(window.out[9][loop.K_DONE])
-        window.r = int(window.out[9][loop.K_DONE])
+                r = int(window.out.counters[loop.K_DONE])
+        window.r = int(window.out.counters[loop.K_DONE])
         return int(status), window.k_base + window.r
 
     def _first_hold(self, stops, collector, window, k_from, k_to):
@@ -508,13 +508,13 @@ class MoreauJean:
         ks = kept_steps(collector.grid, k_from + 1, k_to, collector.save_every)
         ks = ks[ks > k_from]
         rows = ks - window.k_base  # q, v rows copied (fancy indexing): the conditions' own
-        held = first_hold(stops, collector.grid.time(ks), window.out[0][rows], window.out[1][rows])
+        held = first_hold(stops, collector.grid.time(ks), window.out.q[rows], window.out.v[rows])
         return None if held is None else int(ks[held])
 
     def _run_stepwise(self, kernels, scene, r_start, r_end, params, iparams, model, work, out):
         """The loop step by step from Python: for a Python `applied_force` (called back for each
         step's force) and for the Python (QP) solvers."""
-        q, v, counters = out[0], out[1], out[9]
+        q, v, counters = out.q, out.v, out.counters
         f, extra = np.empty(scene.n_dof), np.zeros(scene.n_dof)
         compiled = int(iparams[loop.I_SOLVER]) >= 0  # an exact solver: the compiled loop, one step a call
         motions = self._motions_in_python
@@ -542,7 +542,7 @@ class MoreauJean:
     def _python_solver_step(self, kernels, k, f, params, iparams, model, work, out):
         """One step with a Python solver (QP backends): the loop's kernels around
         solve_two_coefficient."""
-        q, v, counters = out[0], out[1], out[9]
+        q, v, counters = out.q, out.v, out.counters
         kernels.drive_step(k, params, model)
         na = kernels.begin_step(params, q[k], v[k], f, model, work, k, out)
         if na < 0:
@@ -575,7 +575,7 @@ class MoreauJean:
         if status == loop.RUN_STOPPED:
             return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
         out = window.out
-        q, counters = out[0], out[9]
+        q, counters = out.q, out.counters
         t_end = float(grid.time(k_end))
         if status == loop.RUN_STOPPED_BY_CONDITION:
             return Status.STOPPED, stop_message(t_end), stop_event(t_end)
@@ -623,7 +623,7 @@ class MoreauJean:
         run_status, k_end = ending
         status, message, final_event = self._ending(run_status, k_end, grid, window, names)
         impacts, events = self._impacts(scene, grid, collector, names)
-        counters = window.out[9]
+        counters = window.out.counters
         t, q, v, a, N, T, codes = collector.trajectory_arrays()
         modes = _STATE_WORDS.take(codes)
         if k_end == grid.first and collector.resume is None:

@@ -135,7 +135,7 @@ class StickDecisions:
             self._start(window, lo, window.full(5, lo))
         if not self.handled:
             return None
-        columns = window.out[5][lo:r1]  # the contacts' columns (contacts never near: no column, open)
+        columns = window.out.states[lo:r1]  # the contacts' columns (contacts never near: no column, open)
         rows = np.any(columns[1:] != columns[:-1], axis=1)  # (a row changes where its contacts' codes do)
         if not rows.any():
             return None  # (most chunks: no mode changes)
@@ -156,7 +156,7 @@ class StickDecisions:
 
     def _start(self, window, r: int, codes) -> None:
         k = window.k_base + r
-        self.run_start = _ModeRun(k, float(self.grid.time(k)), window.out[0][r].copy(), window.out[1][r].copy(),
+        self.run_start = _ModeRun(k, float(self.grid.time(k)), window.out.q[r].copy(), window.out.v[r].copy(),
                                   np.array(codes))
 
     def _confirm(self, i: int, k_break: int, k_chunk: int) -> int | None:
