@@ -276,7 +276,7 @@ def broad_phase(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, 
                      candidate)
 
 
-@jit_borrowing
+@_inlined  # into its one caller: a dispatcher of its own would optimise its code again there
 def _mark_candidates(h, q, v, disks, disk_body, pair_keys, pair_contact, was_closed, candidate, room):
     """broad_phase, its few-pairs-per-circle test (a tower, a row of dominoes) in the step's
     scratch `room` when its 3 floats a circle and one a dof fit there: broad_phase's four
@@ -373,7 +373,7 @@ BROAD_PHASE_SKIN = 0.2
 BROAD_PHASE_REBUILD = 0.45
 
 
-@jit
+@_inlined  # into its one caller: a dispatcher of its own would optimise its code again there
 def kept_sizes(n_dof, n_circles, n_contacts, n_pairs):
     """The sizes of Scratch.kept (ints: the counts of kept pairs and lines, a (contact, circle,
     circle) triple per kept pair, the kept lines' contacts, then at _visits_at the step's visit
@@ -421,7 +421,7 @@ def _pose_views(kept_pose, n_dof, n_circles):
     return pose, x, y, placed, levers
 
 
-@jit_borrowing
+@_inlined  # into its one caller: a dispatcher of its own would optimise its code again there
 def _circles_now(h, q, v, disks, disk_body, x, y, placed, levers, reach, turn):
     """_disk_reach's centres and reach, the very same floats, on the kept list's memory: a body's
     circles are placed again only when its q changed since they were (a body at rest costs no
@@ -756,7 +756,7 @@ def _block_entries(hn, ht, index, i, j, minv):
     return nn, nt, tn, tt
 
 
-@jit_borrowing
+@_inlined  # into its one caller: a dispatcher of its own would optimise its code again there
 def _contacts_by_body(na, active, index, start, fill, members):
     """start, members: the active contacts (positions in `active`) touching each body, CSR
     (start: n_bodies + 1 entries, members: 2 na; fill: n_bodies + 1 entries of scratch)."""
@@ -825,7 +825,7 @@ def sparse_views(na, n_bodies, nnz, ints, floats):
     return ints[:na + 1], ints[at:at + nnz], floats[:4 * nnz].reshape((nnz, 2, 2))
 
 
-@jit
+@_inlined  # into its one caller: a dispatcher of its own would optimise its code again there
 def _sparse_capacity(index, n_bodies):
     """The most blocks the block-sparse W of any set of active contacts can hold: per contact,
     the contacts touching its bodies."""

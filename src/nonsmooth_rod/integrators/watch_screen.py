@@ -13,7 +13,7 @@ there. A NaN flags its step (the watch then decides, as before).
 """
 from __future__ import annotations
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ..model.dynamics import runge_kutta_into
 
 _TINY = 5e-324  # event_driven._TINY (a test checks): a start value counted as just on the safe side
@@ -61,7 +61,7 @@ def _banded(t, value, t_start, noise, exits, j):
     return _TINY if _TINY > value else value
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _flags(t0, t1, t2, s0, s1, s2, dip_fraction) -> bool:
     """Whether _StepWatch.first_event_sampled looks at an indicator's step closely: a sample not
     safe, or a dip (hybrid._parabola_minimum's vertex at most dip_fraction of the smaller end)."""

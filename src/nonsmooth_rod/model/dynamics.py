@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ..solvers.kernel_base import lu_factor, lu_solve
 from .contact_kernels import (C_LINE_PX, C_LINE_PY, C_MU_D, C_MU_S, C_NX, C_NY, C_OBSTACLE_VX, C_OBSTACLE_VY,
                               C_SURFACE_VELOCITY, KIND_DISK_ON_LINE, N_CONTACT_COLUMNS, _on_fixed_normal,
@@ -219,7 +219,7 @@ class ModeSystem:
                             out[self.matrix].reshape(self.m, self.m), False)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def mode_rates_into(table, ints, watched, offsets, minv, free, y, out) -> bool:
     """The mode solve of mode_dynamics for disks on fixed lines and its watched values
     (`ModeSystem`, out in its layout); False where A is singular (the threshold of
@@ -293,7 +293,7 @@ def hermite_into(weights, h, y0, y1, f0, f1, out):
         out[d] = h00 * y0[d] + h01 * y1[d] + h * (h10 * f0[d] + h11 * f1[d])
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _watched_values(watched, offsets, table, gaps, slips, out, at, nc):
     """The watched values (WATCH_CODES) into out[at:], from the gaps, slips and out's N, T, det."""
     k = watched.shape[0]
@@ -355,7 +355,7 @@ def _solve_mode(C, G, base, owner, role, M, minv, free, table, ints, out, k) -> 
     return True
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _eliminate(M) -> float:
     """Gaussian elimination with partial pivoting of the augmented M = [A | b], in place: the last
     column becomes x (where A is regular); returns det A (0 when a pivot is zero). The package's

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ..solvers._common import interpreted
 from ..validation import InputError, quoted, require_finite, require_nonnegative
 
@@ -270,7 +270,7 @@ def _point_state(q, v, body, px, py):
     return q[j] + dx, q[j + 1] + dy, v[j] - om * dy, v[j + 1] + om * dx
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _spring(q, v, row, body_a, body_b, f):
     xa, ya, vxa, vya = _point_state(q, v, body_a, row[F_PA_X], row[F_PA_Y])
     xb, yb, vxb, vyb = _point_state(q, v, body_b, row[F_PB_X], row[F_PB_Y])
@@ -287,7 +287,7 @@ def _spring(q, v, row, body_a, body_b, f):
         _apply_at_point(f, body_b, row[F_PB_X], row[F_PB_Y], q[3 * body_b + 2], tension * ex, tension * ey, 0.0)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _torsion(q, v, row, body_a, body_b, f):
     """−k (θ_a − θ_b − θ_rest) − c (ω_a − ω_b) on body_a, its opposite on body_b (unless the world)."""
     ja = 3 * body_a + 2
@@ -301,7 +301,7 @@ def _torsion(q, v, row, body_a, body_b, f):
         f[3 * body_b + 2] -= torque
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _tabulated(t, times, values, start, rows):
     """Linear interpolation of the rows [start, start + rows) of (times, values) at t."""
     last = start + rows - 1

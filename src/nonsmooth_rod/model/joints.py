@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ..solvers._common import interpreted
 from ..validation import InputError, quoted, require_finite
 from .contacts import check_linear_row
@@ -183,7 +183,7 @@ def _frame(q, body, px, py):
     return q[j] + dx, q[j + 1] + dy, dx, dy
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _pin_rows(row, a, b, q, J, r):
     xa, ya, dxa, dya = _frame(q, a, row[J_PA_X], row[J_PA_Y])
     xb, yb, dxb, dyb = _frame(q, b, row[J_PB_X], row[J_PB_Y])
@@ -197,7 +197,7 @@ def _pin_rows(row, a, b, q, J, r):
     return xa - xb, ya - yb
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _slider_rows(row, a, b, q, J, r):
     xa, ya, dxa, dya = _frame(q, a, row[J_PA_X], row[J_PA_Y])
     xb, yb, dxb, dyb = _frame(q, b, row[J_PB_X], row[J_PB_Y])
@@ -217,7 +217,7 @@ def _slider_rows(row, a, b, q, J, r):
     return nx * ex + ny * ey, q[ja + 2] - theta_b - row[J_ANGLE]
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def check_linear_rows(row, a, b, q, J, r):
     """c + w·q and its constant row; the joint's second row stays zero."""
     c = row[J_ANGLE]

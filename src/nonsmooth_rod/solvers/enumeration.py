@@ -58,7 +58,7 @@ def _mode_table(n_contacts: int) -> np.ndarray:
     return table
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _mode_system(W, q, lo, hi, modes, A, b):
     """The linear system A p = b of one mode combination (module docstring), in place."""
     n = q.shape[0]
@@ -84,7 +84,7 @@ def _mode_system(W, q, lo, hi, modes, A, b):
             A[T, N] = -(lo[i] if mode == STATE_SLIP_PLUS else hi[i])
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _mode_inequalities(W, q, lo, hi, modes, G, h):
     """G p + h ≥ 0: what the mode combination still needs, 3 rows per contact (unused rows
     are 0·p + 1 ≥ 0), in place."""

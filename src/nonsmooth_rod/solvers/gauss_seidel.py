@@ -126,7 +126,7 @@ def block_velocities(indptr, indices, blocks, q, p, u):
         u[2 * i + 1] = u_t
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _diagonal_positions(indptr, indices, diagonal):
     """diagonal[i]: the position in `blocks` of contact i's diagonal block (−1 if missing)."""
     for i in range(indptr.shape[0] - 1):
@@ -136,7 +136,7 @@ def _diagonal_positions(indptr, indices, diagonal):
                 diagonal[i] = k
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p):
     """One Gauss–Seidel sweep over the contacts, updating p in place."""
     for i in range(indptr.shape[0] - 1):
@@ -160,7 +160,7 @@ def pgs_sweep(indptr, indices, blocks, diagonal, q, lo, hi, p):
 PGS_FLOATS = STALL_SWEEPS
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _finite_problem(blocks, q, lo, hi, p):
     """True when the blocks, q, lo, hi and the warm start p are all finite (loops: all_finite's
     ravel is not for a borrowing caller)."""
@@ -344,7 +344,7 @@ def pgs_dense_floats(n_contacts):
     return 4 * n_contacts * n_contacts + PGS_FLOATS
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def pgs_dense_ints(n_contacts):
     """int64s pgs_dense_into takes: the blocks' row starts and columns, the diagonal's positions."""
     return n_contacts * n_contacts + 2 * n_contacts + 1

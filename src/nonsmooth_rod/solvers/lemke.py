@@ -50,7 +50,7 @@ import time
 
 import numpy as np
 
-from .._jit import ENABLED as HAVE_NUMBA
+from .._jit import ENABLED as HAVE_NUMBA, jit_inline
 from .._jit import jit, jit_borrowing, jit_inline
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
@@ -297,7 +297,7 @@ def _lemke_kernel(M, q, max_pivots, T, basis, z, residual):
     return status, pivots, entering
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
     """The 3-per-contact LCP of the module docstring, from W / w_scale and q / q_scale."""
     n_c = len(lo)
@@ -318,7 +318,7 @@ def _fill_interval_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
         qq[3 * i + 1] = q[2 * i + 1] / q_scale
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
     """The 4-per-contact (Anitescu–Potra) LCP of the module docstring, scaled likewise."""
     n_c = len(lo)
@@ -352,7 +352,7 @@ def _fill_cone_lcp(M, qq, W, q, lo, hi, w_scale, q_scale):
         qq[4 * i + 2] = lo[i] * q[2 * i + 1] / q_scale
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _contact_scales(W, n_c, d):
     """d: per contact the power of two nearest 1/√max(W_NN, W_TT) (1 for a zero block)."""
     for c in range(n_c):
@@ -362,7 +362,7 @@ def _contact_scales(W, n_c, d):
             d[c] = 2.0 ** (-np.round(0.5 * np.log2(diagonal)))
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _scaled_step(W, q, d, Ws, qs):
     """Ws = D W D, qs = D q; returns (max|W|, max|q|, max|Ws| or 1, max|qs| or 1)."""
     W_norm, q_norm, ws_norm, qs_norm = 0.0, 0.0, 0.0, 0.0
@@ -436,7 +436,7 @@ def _lemke_friction_into(W, q, lo, hi, max_pivots, formulation, floats, ints, p,
     return residual, status, pivots, q_norm, W_norm, scale
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _impulses_of(z, d, to_units, formulation, W, q, lo, hi, q_norm, p, u):
     """p from the LCP's z (per contact d_c · to_units undoes the scaling), u = W p + q:
     (residual, max(‖q‖∞, ‖p‖∞, ‖u‖∞)). z = 0 gives p = 0, u = q."""
@@ -453,7 +453,7 @@ def _impulses_of(z, d, to_units, formulation, W, q, lo, hi, q_norm, p, u):
     return residual, max(q_norm, _max_abs(p), _max_abs(u))
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def _warm_basis(p, lo, hi, basic):
     """The complementary basis of the interval LCP that the impulses p sit at: basic[k] = 1
     when z_k is basic (else its w_k is). Per contact (p_N, β, σ): p_N basic when p_N > 0; β

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 
-from .._jit import jit_borrowing
+from .._jit import jit_borrowing, jit_inline
 from .kernel_base import DEFAULT_RTOL, one_contact_residual
 
 # Relative margins of the conditions above: closer to them the problem is left to the solver
@@ -35,7 +35,7 @@ STIFFNESS_MARGIN = 1e-8
 SINGULAR_MARGIN = 1e-10
 
 
-@jit_borrowing
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def one_contact_impulse(a, b_nt, b_tn, c, q_n, q_t, lo, hi):
     """(found, p_N, p_T) of the one-contact problem above; found False when the conditions for a
     unique solution do not hold (or a datum is not finite): the caller's solver decides then."""

@@ -492,7 +492,7 @@ def admissible_split_in(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out
                                p_out, max(1e-300, _max_abs(W)), floats, ints)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def search_floats(na):
     """Floats one hold search on na contacts takes (a held-set trial's own, then
     _deepest_admissible's with up to 2 na unknowns z): allocated once per search, carved by each LP."""
@@ -506,7 +506,7 @@ def _admissible_floats(na, k):
     return 4 * na + 2 * na * k + 4 * na * (k + 2) + k + lp_floats(4 * na + 2 * k + 1, 2 * k + 2)
 
 
-@jit
+@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
 def search_ints(na):
     """int64s one hold search on na contacts takes (a trial's and the LP's)."""
     k = 2 * na
