@@ -196,7 +196,7 @@ def enum_candidates(W, q, lo, hi, table, rcond):
     return P, U, residuals, scales
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def _mode_row(k, n_contacts):
     """Combination k of the table's order (itertools.product: the first contact varies slowest)."""
     modes = np.zeros(n_contacts, dtype=np.int64)
@@ -215,7 +215,7 @@ def enum_table(n_contacts):
     return table
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def choose_candidate(residuals, scales, P, rtol):
     """Index of the returned candidate (−1 if none valid) and the number of valid ones.
 

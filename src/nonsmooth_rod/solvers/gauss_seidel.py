@@ -247,7 +247,7 @@ def _mode_solution(A, b):
     return x if certain else np.linalg.lstsq(A, b)[0]
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def _certified_square_solution(A, b):
     """(True, A⁻¹ b) through the QR of Aᵀ when A is square and ‖R‖_F ‖R⁻¹‖_F < 1/RANK_TOL, else
     (False, ·)."""

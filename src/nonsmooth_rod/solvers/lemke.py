@@ -94,7 +94,7 @@ WARM_BOUND_TOL = 1e-9
 # The pivoting and its helpers are compiled without reference counting (_jit.jit_borrowing): they
 # take arrays and return numbers, so any caller may call them, and the row views they take in
 # their loops (a pivot touches every row) count nothing.
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit_borrowing
 def _fill_tableau(T, M, q, n):
     """T = [I | −M | −d | q] with covering vector d = (1, …, 1); T must be zero on entry."""
     for i in range(n):
@@ -126,7 +126,7 @@ def _pivot(T, r, e):
                 other[e] = 0.0
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit_borrowing
 def _lex_smaller(T, i, k, e, n):
     """Is row i's (rhs, B⁻¹ row)/T[i, e] lexicographically smaller than row k's?
 
@@ -154,7 +154,7 @@ def _lex_smaller(T, i, k, e, n):
     return False
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit_borrowing
 def _first_leaving_row(T, n, rhs):
     """Entering z0 drives w up by z0·d; the row that leaves is the lexicographic minimum of
     (q_i, e_i): the most negative q_i, ties to the LARGEST index (e_i is lexicographically
@@ -170,7 +170,7 @@ def _first_leaving_row(T, n, rhs):
     return r
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit_borrowing
 def _prefer_z0(T, r, z0_row, entering, rhs, pivot_tol):
     """If z0 ties for leaving, let it leave: that ends the method with a solution."""
     a0 = T[z0_row, entering]
@@ -242,7 +242,7 @@ def _resume_pivoting(T, basis, n, entering, pivots, max_pivots):
         entering = leaving + n if leaving < n else leaving - n
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit_borrowing
 def _basic_solution(T, basis, M, q, n, z, residual):
     """z from the final basis, with one step of iterative refinement against the original M, q
     (`residual`: n floats of scratch).

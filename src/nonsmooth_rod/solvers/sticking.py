@@ -375,7 +375,7 @@ def _law_row(G, h, weight, n, rows, row, factor, divisor, value, row_weight):
     weight[n] = row_weight
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def _fixed_split_margin(h, weight):
     """_deepest_split with no unknown z, in closed form: t = min(1, h_r / weight_r over the
     weighted rows), or −inf when a hard row (weight 0) is violated beyond simplex_max's phase-1
@@ -439,7 +439,7 @@ def lp_floats(rows, n):
     return simplex_floats(rows, n) + n
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def lp_scratch(floats, ints, rows, n):
     """(floats, ints) when they hold _deepest_split's LP of `rows` constraints on n unknowns, else
     buffers of its own."""
@@ -632,7 +632,7 @@ def _modes_for(held_mask, candidates, release, n_candidates, u, states, mode, si
             sign[i] = release[c]
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def _binomial(n, k):
     """n choose k (n ≤ 62: the candidates' bit mask)."""
     value = 1
@@ -900,7 +900,7 @@ def held_set(relaxed, W, q, q_held, closing, mu_s, mu_d, candidates, release, n_
         allowed = common
 
 
-@jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
+@jit
 def _small_inverse(S, s, LU, rows, inverse):
     """inverse = S⁻¹ of the leading s × s block of S (the package's LU, kernel_base.lu_factor: in
     LU and rows, scratch), allocating nothing; infinities when a pivot is zero (they fail the
