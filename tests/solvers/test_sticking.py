@@ -462,6 +462,19 @@ def _row_cluster(rng, balls):
     return (W, q, mu_s, mu_d) + _lemke_start(W, q, mu_s)
 
 
+def _search_start(kernel, rng):
+    """A random row cluster at its Lemke start and what a hold search starts from: the tolerance,
+    the impulse scale, the resting candidates (_resting_contacts) and empty mode and sign arrays."""
+    W, q, mu_s, mu_d, p, u, states = _row_cluster(rng, int(rng.integers(3, 7)))
+    na = len(mu_s)
+    tol = 1e-9 * np.max(np.abs(q))
+    scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / np.max(np.abs(W)))
+    candidates, release = np.empty(na, dtype=np.int64), np.empty(na)
+    n_c = kernel("_resting_contacts")(np.zeros(na), p, u, np.zeros(na), states, tol, candidates, release, False)
+    return (W, q, mu_s, mu_d, p, u, states, tol, scale, candidates, release, n_c,
+            np.zeros(na, dtype=np.int64), np.zeros(na))
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 def test_held_set_trials_through_the_shared_factorization_are_the_general_ones(compiled):
     """A held-set trial solved by bordering the all-released mode (_bordered_split: one QR per
@@ -474,13 +487,8 @@ def test_held_set_trials_through_the_shared_factorization_are_the_general_ones(c
     rng = np.random.default_rng(26)
     vouched = declined = admissible = 0
     for _ in range(12 if compiled else 4):
-        W, q, mu_s, mu_d, p, u, states = _row_cluster(rng, int(rng.integers(3, 7)))
+        W, q, mu_s, mu_d, p, u, states, tol, scale, candidates, release, n_c, mode, sign = _search_start(kernel, rng)
         na = len(mu_s)
-        tol = 1e-9 * np.max(np.abs(q))
-        scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / np.max(np.abs(W)))
-        candidates, release = np.empty(na, dtype=np.int64), np.empty(na)
-        n_c = kernel("_resting_contacts")(np.zeros(na), p, u, np.zeros(na), states, tol, candidates, release, False)
-        mode, sign = np.zeros(na, dtype=np.int64), np.zeros(na)
         shared = kernel("_bordered_trials")(W, mu_d, candidates, release, n_c, u, states, mode, sign,
                                             *kernel("search_scratch")(na))
         for held in range(1 << n_c):
@@ -565,13 +573,8 @@ def test_pruning_lps_on_the_shared_relaxation_decide_as_the_general_ones(compile
     rng = np.random.default_rng(27)
     vouched = declined = agreed = 0
     for _ in range(12 if compiled else 4):
-        W, q, mu_s, mu_d, p, u, states = _row_cluster(rng, int(rng.integers(3, 7)))
+        W, q, mu_s, mu_d, p, u, states, tol, scale, candidates, release, n_c, mode, sign = _search_start(kernel, rng)
         na = len(mu_s)
-        tol = 1e-9 * np.max(np.abs(q))
-        scale = max(np.max(np.abs(p)), np.max(np.abs(q)) / np.max(np.abs(W)))
-        candidates, release = np.empty(na, dtype=np.int64), np.empty(na)
-        n_c = kernel("_resting_contacts")(np.zeros(na), p, u, np.zeros(na), states, tol, candidates, release, False)
-        mode, sign = np.zeros(na, dtype=np.int64), np.zeros(na)
         relaxed = kernel("_relaxed_base")(W, mu_d, candidates, release, n_c, u, states, mode, sign,
                                           *kernel("search_scratch")(na))
         for c in range(n_c):
