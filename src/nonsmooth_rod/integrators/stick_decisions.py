@@ -1,5 +1,5 @@
 """Break-aways of fixed-step Moreau–Jean confirmed by the smooth phase's prediction, not decided by
-a step's overshoot (issue 28). docs/friction.md ("Break-away at fixed steps") has the why and the
+a step's overshoot (issue 28). docs/friction.md ("Break-aways at fixed steps") has the why and the
 measurements.
 
 A Moreau–Jean step holds a loaded contact with its Jacobian at the step's start: its ratio p_T/p_N
@@ -37,9 +37,8 @@ starts from its exact initial state; a stick that starts after a slide starts fr
 state there, with its O(h) error. Scenes the hybrid method does not run (other contacts than disks
 and points on fixed lines, joints, driven things), and modes its compiled mode solve declines
 (a statically indeterminate stick: two disks of a block sticking on a belt), are left to the
-step's law, as before. A run
-resumed from an earlier one starts its first run of modes at its first step (the earlier run's
-holds are not carried over).
+step's law, as before. A run resumed from an earlier one starts its first run of modes at its
+first step (the earlier run's holds are not carried over).
 """
 from __future__ import annotations
 
