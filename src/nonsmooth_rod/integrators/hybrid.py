@@ -389,6 +389,11 @@ class Hybrid(EventDriven):
             tb.append(tb[-1] + step)
         return tb, steps
 
+    def may_solve_compiled(self, scene, modes) -> bool:
+        """Whether the compiled mode solve solves `modes` at some state (solves_compiled before a
+        state is known: its contacts, no body held by more rows than its freedoms)."""
+        return self._system(scene, modes).usable
+
     def solves_compiled(self, scene, t: float, q, v, modes) -> bool:
         """Whether `modes` at (t, q, v) are solved by the compiled mode solve (not mode_dynamics,
         ~10 times slower a step: a statically indeterminate stick, a singular A)."""
