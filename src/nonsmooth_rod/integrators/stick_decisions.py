@@ -45,7 +45,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -70,10 +70,10 @@ RELEASE_STEPS = 2
 SLIDING = (STATE_SLIP_PLUS, STATE_SLIP_MINUS)
 NOT_PREDICTED = "not predicted"  # a mode run the compiled mode solve declines: the step's law decides
 MAX_PREDICTORS = 2  # predicting Hybrids a scene's plan keeps (threads running the scene at once)
+_NO_HOLDS = contextlib.nullcontext()  # (reusable: it does nothing on entering and leaving)
 
 
-@dataclass(frozen=True)
-class _ModeRun:
+class _ModeRun(NamedTuple):  # (a tuple: made at every call's first review, a frozen dataclass costs a µs more)
     """The first step of a run of steps with unchanged contact modes: its state and modes."""
 
     k: int
@@ -116,14 +116,18 @@ class StickDecisions:
     def steps(self, k: int, n: int) -> int:
         """n steps from step k, cut so that a chunk starts at every planned hold's and release's
         first and last step."""
+        if not (self.held or self.released):
+            return n  # (a run without holds: every call's first chunk)
         bounds = [b for plan in (self.held, self.released) for span in plan.values() for b in span]
         return min([n] + [b - k for b in bounds if b > k])
 
     def holding(self, k: int):
         """The context the chunk from step k runs in: its held contacts' friction raised in the
         packed table, its released ones' μs lowered to μd (restored after)."""
+        if not (self.held or self.released):
+            return _NO_HOLDS
         held, released = _during(self.held, k), _during(self.released, k)
-        return self.smooth.Held(self.table, held, released) if held or released else contextlib.nullcontext()
+        return self.smooth.Held(self.table, held, released) if held or released else _NO_HOLDS
 
     def review(self, window, k: int, k_done: int) -> int | None:
         """The step the chunk's steps k … k_done − 1 are taken back to (its records and state from
