@@ -159,8 +159,10 @@ class ModeSystem:
     For a body's disks and points on fixed lines (the contacts the hybrid method runs) whose
     constrained system is regular; `evaluate` returns None elsewhere — a statically indeterminate
     A (two sticking corners of a block at rest), whose split mode_dynamics chooses — and the caller
-    falls back on mode_dynamics. `watched`: (what, contact, offset) triples, `what` a key of
-    WATCH_CODES; each value is the quantity minus the offset."""
+    falls back on mode_dynamics. `usable`: False where that is known from the modes alone (other
+    contacts; a body held by more rows than its freedoms, `indeterminate_everywhere`).
+    `watched`: (what, contact, offset) triples, `what` a key of WATCH_CODES; each value is the
+    quantity minus the offset."""
 
     def __init__(self, scene: Scene, modes, watched=(), like: ModeSystem | None = None):
         n, nc = scene.n_dof, len(scene.contacts)
