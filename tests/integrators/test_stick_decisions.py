@@ -134,3 +134,36 @@ def test_a_scenes_later_runs_reuse_its_predictor_with_the_same_decisions():
     assert plan.predictors == [kept] and again.stats["stick_predictions"] == first.stats["stick_predictions"] >= 1
     assert np.array_equal(first.q, again.q) and np.array_equal(first.v, again.v)
     assert [e.t for e in first.events] == [e.t for e in again.events]
+
+
+def test_a_statically_indeterminate_stick_is_left_to_the_step(monkeypatch):
+    """The pushed block sticks on two corners (four rows of A for three freedoms: singular at
+    every state, a split the compiled mode solve does not choose): its break-away is not predicted
+    (no mode solve, no projection), so the run is the step's law's bit for bit, each corner's
+    onset within a step of the closed form t* = μs m g / rate."""
+    block = toys.PushedBlock()
+    scene, (q0, v0) = block.scene(), block.initial_state()
+    run = nr.simulate(scene, q0, v0, 0.6, "moreau-jean", h=H)
+    monkeypatch.setattr(moreau_jean, "stick_decisions", lambda *args: None)
+    alone = nr.simulate(scene, q0, v0, 0.6, "moreau-jean", h=H)
+    assert np.array_equal(run.q, alone.q) and np.array_equal(run.v, alone.v)
+    assert run.stats["stick_predictions"] == 0
+    onsets = [next(p.t_start for p in run.phases[c.name] if p.mode.startswith("slip")) for c in scene.contacts]
+    assert max(abs(t - block.onset_time) for t in onsets) <= H
+
+
+def test_contacts_declared_in_another_order_get_the_same_decisions():
+    """The rod's balls declared B first: A, the one sticking, takes the records' first column
+    (Window.columns: columns in the order contacts become candidates; B, in the air, has none),
+    so the review maps columns to contacts. δ = +1e-6: the stick still ends where the
+    reference's does, by the one prediction."""
+    from nonsmooth_rod.model.scene import Scene
+
+    problem = RodProblem.paper(None, mu_s=_peak() + 1e-6, mu_d=0.2)
+    declared = problem.scene()
+    scene, (q0, v0) = Scene(declared.bodies, declared.contacts[::-1], gravity=declared.gravity), problem.initial_state()
+    reference = nr.simulate(scene, q0, v0, 0.38, "event-driven")
+    run = nr.simulate(scene, q0, v0, 0.38, "moreau-jean", h=H)
+    assert [c.name for c in scene.contacts] == ["B", "A"] and run.stats["stick_predictions"] == 1
+    assert [p.mode for p in run.phases["A"]] == [p.mode for p in reference.phases["A"]] == ["stick", "slip+"]
+    assert abs(run.phases["A"][0].t_end - reference.phases["A"][0].t_end) < 1e-6

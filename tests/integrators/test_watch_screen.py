@@ -27,10 +27,6 @@ def _stepwise(predictor, scene, t, q, v, modes, t_end):
     return None if hit is None else (float(hit[0]), indicators[hit[1]].kind, indicators[hit[1]].contact)
 
 
-def test_tiny_is_the_watchs():
-    assert watch_screen._TINY == event_driven._TINY
-
-
 @pytest.mark.parametrize("delta", [1e-6, -1e-6, -0.02])
 def test_screened_prediction_is_the_stepwise_one(delta):
     """μs = max T/N + δ: from states along a fixed-step run, in its modes, all sticking, all

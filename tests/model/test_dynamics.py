@@ -13,7 +13,7 @@ import pytest
 
 from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import DiskOnLine, Line
-from nonsmooth_rod.model.dynamics import WATCH_CODES, ModeSystem, mode_dynamics
+from nonsmooth_rod.model.dynamics import WATCH_CODES, ModeSystem, indeterminate_everywhere, mode_dynamics
 from nonsmooth_rod.model.forces import Spring
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
@@ -90,6 +90,34 @@ def test_a_block_on_two_sticking_corners_is_left_to_mode_dynamics():
     assert ModeSystem(scene, modes, [("normal", 0, 0.0)]).evaluate(0.0, np.concatenate([q, v])) is None
     assert mode_dynamics(scene, 0.0, q, v, modes).singular
     assert ModeSystem(scene, ["stick", "open"]).evaluate(0.0, np.concatenate([q, v])) is not None
+
+
+def _block_on_three_corners() -> Scene:
+    """A block with two corners on the floor and one on a wall (a slanted line): 3 contacts, 3 freedoms."""
+    law = ContactLaw.of(mu_s=0.5, mu_d=0.4)
+    corners = [DiskOnLine(0, (-0.2, -0.3), Line(), law=law, name="left"),
+               DiskOnLine(0, (0.2, -0.3), Line(), radius=0.01, law=law, name="right"),
+               DiskOnLine(0, (0.2, 0.3), Line(point=(0.3, 0.0), angle=1.9), law=law, name="wall")]
+    return Scene([RigidBody(mass=2.0, inertia=0.1)], corners)
+
+
+@pytest.mark.parametrize("modes", list(itertools.product(MODES, repeat=3)))
+def test_a_block_on_three_corners_every_mode_as_mode_dynamics(modes):
+    """Every mode of three contacts of one body: those holding it by more rows than its three
+    freedoms (indeterminate_everywhere: two sticking corners, or a sticking one and two closed)
+    are singular at every state for mode_dynamics too, and declined without a compiled solve
+    (`usable` False: a prediction of them costs no mode solve); the others are solved as
+    mode_dynamics solves them, to round-off, at random states."""
+    scene, modes = _block_on_three_corners(), list(modes)
+    rng = np.random.default_rng(sum(MODES.index(m) * 4 ** i for i, m in enumerate(modes)))
+    states = [(np.array([0.0, 0.3, 0.0]) + 0.1 * rng.standard_normal(3), rng.standard_normal(3)) for _ in range(4)]
+    rows = sum({"open": 0, "stick": 2}.get(mode, 1) for mode in modes)
+    assert indeterminate_everywhere(ModeSystem(scene, modes).bodies, modes) == (rows > 3)
+    if rows > 3:
+        assert not ModeSystem(scene, modes).usable
+        assert all(mode_dynamics(scene, 0.3, q, v, modes).singular for q, v in states)
+    for q, v in states:
+        _compare(scene, modes, q, v)
 
 
 RK4_A = np.array([[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])

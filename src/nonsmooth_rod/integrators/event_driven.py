@@ -65,6 +65,7 @@ from ..solvers.registry import SolverName
 from . import accumulation
 from .declaration import NO_DRIVEN, NO_JOINTS, STEP_CAP, Declaration, Refusal, first_item
 from .sampling import OUTPUT_DT_KNOB, Thinning, grid_blocks, stop_event, stop_message, output_dt_samples
+from .watch_tests import TINY, start_band
 
 ODE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # scipy's ODE solvers raise a smaller rtol to 100 ε with a warning: refuse it instead.
@@ -213,7 +214,7 @@ _CHEB_X = -np.cos(np.pi * np.arange(_NODES) / (_NODES - 1))  # Chebyshev–Lobat
 _CHEB_FIT = np.linalg.inv(chebyshev.chebvander(_CHEB_X, _NODES - 1))  # values → coefficients
 _MAX_BISECTIONS = 4
 _EPS = float(np.finfo(float).eps)
-_TINY = 5e-324  # a start value counted as just on the safe side
+_TINY = TINY  # a start value counted as just on the safe side (watch_tests)
 
 
 def _interior_extrema(coef) -> np.ndarray:
@@ -298,14 +299,9 @@ class _Watch:
         return self.sign * _indicator_values(self.scene, self.modes, self.indicators, t, dense(t))
 
     def _start_band(self, j, ts, s):
-        """Count values safe (in place) from the segment start until the indicator leaves its band."""
-        for k in range(len(ts)):
-            if ts[k] >= self.band_exit[j]:
-                return
-            if ts[k] > self.t0 and abs(s[k]) > self.noise[j]:
-                self.band_exit[j] = ts[k]
-                return
-            s[k] = max(s[k], _TINY)
+        """Count values safe (in place) from the segment start until the indicator leaves its band
+        (watch_tests.start_band: the compiled screen's too)."""
+        start_band(ts, s, self.t0, self.noise[j], self.band_exit, j)
 
     def first_event(self, dense, a, b, depth=0):
         """(t, j): the first crossing in [a, b] and which indicator makes it; None if none."""

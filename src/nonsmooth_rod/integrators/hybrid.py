@@ -38,6 +38,7 @@ from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
 from .sampling import thinned_count
 from .watch_screen import screened_steps_into
+from .watch_tests import looked_at, start_band
 from .event_driven import (_EPS, _TINY, EventDriven, _first_of, _force_scale, _indicator_values, _indicators,
                            _Watch)
 
@@ -168,19 +169,18 @@ class _StepWatch(_Watch):
         """(t, j): the first crossing in [ts[0], ts[-1]] given the safe values s (3 × indicators)."""
         found = []
         for j, column in enumerate(s.T.tolist()):  # Python floats: the three samples' tests are scalar
-            self._start_band(j, ts, column)
-            vertex = _parabola_minimum(ts, column)
-            dip = vertex is not None and vertex[1] <= DIP_FRACTION * min(column[0], column[-1])
-            if min(column) > 0.0 and not dip:
+            start_band(ts, column, self.t0, self.noise[j], self.band_exit, j)
+            looked, dip, t_vertex = looked_at(ts[0], ts[1], ts[2], column[0], column[1], column[2], DIP_FRACTION)
+            if not looked:
                 continue
             # Looked at closely on the interpolant: the middle sample (a stage's state, not the
             # interpolant's) is taken again from it, so that the brackets are the root finder's.
             column[1] = self.safe_values(ts[1], dense)[j]
             nodes_t, nodes_s = list(ts), list(column)
             if dip and min(column) > 0.0:
-                k = 1 if vertex[0] <= ts[1] else 2
-                nodes_t.insert(k, vertex[0])
-                nodes_s.insert(k, self.safe_values(vertex[0], dense)[j])
+                k = 1 if t_vertex <= ts[1] else 2
+                nodes_t.insert(k, t_vertex)
+                nodes_s.insert(k, self.safe_values(t_vertex, dense)[j])
             self._start_band(j, nodes_t, nodes_s)
             self._refine_near_misses(j, nodes_t, nodes_s, dense, math.inf)
             self._leave_start_band(j, nodes_t, nodes_s, dense)
@@ -211,19 +211,6 @@ def _combine(y, h, weights, stages) -> np.ndarray:
         if w:
             total = w * stage.f if total is None else total + w * stage.f
     return y + h * total
-
-
-def _parabola_minimum(ts, s):
-    """(t, value) of the interior minimum of the parabola through three samples, or None."""
-    (t0, t1, t2), (s0, s1, s2) = ts, s
-    d01, d12 = (s1 - s0) / (t1 - t0), (s2 - s1) / (t2 - t1)
-    curvature = (d12 - d01) / (t2 - t0)
-    if not curvature > 0.0:
-        return None
-    t_v = 0.5 * (t0 + t1) - d01 / (2.0 * curvature)
-    if not t0 < t_v < t2:
-        return None
-    return t_v, s0 + d01 * (t_v - t0) + curvature * (t_v - t0) * (t_v - t1)
 
 
 def _first_step_cap(boundaries: list) -> float:
@@ -388,6 +375,11 @@ class Hybrid(EventDriven):
             steps.append(step)
             tb.append(tb[-1] + step)
         return tb, steps
+
+    def may_solve_compiled(self, scene, modes) -> bool:
+        """Whether the compiled mode solve solves `modes` at some state (solves_compiled before a
+        state is known: its contacts, no body held by more rows than its freedoms)."""
+        return self._system(scene, modes).usable
 
     def solves_compiled(self, scene, t: float, q, v, modes) -> bool:
         """Whether `modes` at (t, q, v) are solved by the compiled mode solve (not mode_dynamics,

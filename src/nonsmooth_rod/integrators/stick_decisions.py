@@ -45,7 +45,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -70,17 +70,17 @@ RELEASE_STEPS = 2
 SLIDING = (STATE_SLIP_PLUS, STATE_SLIP_MINUS)
 NOT_PREDICTED = "not predicted"  # a mode run the compiled mode solve declines: the step's law decides
 MAX_PREDICTORS = 2  # predicting Hybrids a scene's plan keeps (threads running the scene at once)
+_NO_HOLDS = contextlib.nullcontext()  # (reusable: it does nothing on entering and leaving)
 
 
-@dataclass(frozen=True)
-class _ModeRun:
+class _ModeRun(NamedTuple):  # (a tuple: made at every call's first review, a frozen dataclass costs a µs more)
     """The first step of a run of steps with unchanged contact modes: its state and modes."""
 
     k: int
     t: float
     q: np.ndarray
     v: np.ndarray
-    codes: np.ndarray
+    codes: tuple  # each contact's state code (Python ints: read one at a time)
 
 
 def stick_decisions(scene, model, grid, plan=None):
@@ -116,14 +116,18 @@ class StickDecisions:
     def steps(self, k: int, n: int) -> int:
         """n steps from step k, cut so that a chunk starts at every planned hold's and release's
         first and last step."""
+        if not (self.held or self.released):
+            return n  # (a run without holds: every call's first chunk)
         bounds = [b for plan in (self.held, self.released) for span in plan.values() for b in span]
         return min([n] + [b - k for b in bounds if b > k])
 
     def holding(self, k: int):
         """The context the chunk from step k runs in: its held contacts' friction raised in the
         packed table, its released ones' μs lowered to μd (restored after)."""
+        if not (self.held or self.released):
+            return _NO_HOLDS
         held, released = _during(self.held, k), _during(self.released, k)
-        return self.smooth.Held(self.table, held, released) if held or released else contextlib.nullcontext()
+        return self.smooth.Held(self.table, held, released) if held or released else _NO_HOLDS
 
     def review(self, window, k: int, k_done: int) -> int | None:
         """The step the chunk's steps k … k_done − 1 are taken back to (its records and state from
@@ -135,28 +139,31 @@ class StickDecisions:
         if not self.handled:
             return None
         columns = window.out.states[lo:r1]  # the contacts' columns (contacts never near: no column, open)
-        rows = np.any(columns[1:] != columns[:-1], axis=1)  # (a row changes where its contacts' codes do)
-        if not rows.any():
+        differ = np.flatnonzero(columns[1:] != columns[:-1])  # (flat: an any(axis=1) costs 5 µs a chunk)
+        if not differ.size:
             return None  # (most chunks: no mode changes)
-        codes, p_normal = window.full(5, slice(lo, r1)), window.full(2, slice(lo, r1))
-        changed = np.flatnonzero(rows) + 1
-        # each change's loaded contacts sticking before it and sliding after, at once (per change,
-        # the few rows' numpy calls cost more than the comparisons)
-        after = codes[changed]
-        broke = ((codes[changed - 1] == STATE_STICK) & (p_normal[changed - 1] > 0.0)
-                 & ((after == SLIDING[0]) | (after == SLIDING[1])))
-        for c, contacts in zip(changed.tolist(), broke.tolist()):
-            for i in (i for i, b in enumerate(contacts) if b):
-                back = self._confirm(i, window.k_base + lo + c, k)
-                if back is not None:
-                    return back
-            self._start(window, lo + c, codes[c])
+        width, out = columns.shape[1], window.out
+        changed = sorted({lo + 1 + f // width for f in differ.tolist()})  # rows whose codes differ from the row before
+        start = None
+        for r in changed:  # (few: Python on their rows costs less than numpy's calls over them)
+            broke = [c for c, (was, now, p) in enumerate(zip(out.states[r - 1].tolist(), out.states[r].tolist(),
+                                                            out.p_normal[r - 1].tolist()))
+                     if was == STATE_STICK and p > 0.0 and now in SLIDING]  # loaded, sticking, then sliding
+            if broke:
+                if start is not None:  # the mode run the break-away ends started at the change before it
+                    self._start(window, start, window.full(5, start))
+                for i in sorted(window.owners()[broke].tolist()):  # (each contact's column: Window.columns)
+                    back = self._confirm(i, window.k_base + r, k)
+                    if back is not None:
+                        return back
+            start = r
+        self._start(window, start, window.full(5, start))
         return None
 
     def _start(self, window, r: int, codes) -> None:
         k = window.k_base + r
         self.run_start = _ModeRun(k, float(self.grid.time(k)), window.out.q[r].copy(), window.out.v[r].copy(),
-                                  np.array(codes))
+                                  tuple(codes.tolist()))
 
     def _confirm(self, i: int, k_break: int, k_chunk: int) -> int | None:
         """The step to go back to for contact i's break-away, the first step it slides in being
@@ -194,13 +201,12 @@ class StickDecisions:
             self.switches.update({(i, j): t_switch for j in range(k, k + RELEASE_STEPS + 1)})
 
     def _planned(self, i: int, k: int) -> bool:
-        return i in _during(self.held, k) or i in _during(self.released, k)
+        return bool(self.held or self.released) and (i in _during(self.held, k) or i in _during(self.released, k))
 
     def _predicts(self) -> bool:
         """Whether the hybrid method runs the scene (set up at the first call: 0.2 s of imports)."""
         if self.smooth is None and self.handled:
-            from . import adaptive_breakaway
-            from .hybrid import handles
+            adaptive_breakaway, handles = _smooth_phase()
             self.handled = handles(self.scene) if self.plan is None or self.plan.predicted is None else True
             if self.plan is not None:
                 self.plan.predicted = self.handled
@@ -214,14 +220,14 @@ class StickDecisions:
         the run: the belt oscillator's statically indeterminate block, 0.3 s a prediction)."""
         if start.k not in self._ahead:
             modes = [STATE_NAMES[int(c)] for c in start.codes]
-            v = self.smooth.consistent_velocity(self.scene, start.q, start.v, modes)
             hybrid = self._predictor()
-            try:
-                if hybrid.solves_compiled(self.scene, start.t, start.q, v, modes):
+            self._ahead[start.k] = NOT_PREDICTED
+            try:  # (a stick singular at every state, the pushed block's: declined before the projection)
+                v = self.smooth.consistent_velocity(self.scene, start.q, start.v, modes) \
+                    if hybrid.may_solve_compiled(self.scene, modes) else None
+                if v is not None and hybrid.solves_compiled(self.scene, start.t, start.q, v, modes):
                     self.predictions += 1
                     self._ahead[start.k] = hybrid.first_event(self.scene, start.t, start.q, v, modes, self.grid.t_end)
-                else:
-                    self._ahead[start.k] = NOT_PREDICTED
             finally:
                 # (not one holding many mode solves: a frictionless contact's margin, part of their
                 # key, changes from state to state)
@@ -242,6 +248,15 @@ class StickDecisions:
     def _step_holding(self, t: float) -> int:
         """The step whose interval [t_k, t_k+1) holds t (at most the grid's last)."""
         return min(int(math.floor((t - self.grid.origin) / self.grid.h)), self.grid.last)
+
+
+@functools.cache
+def _smooth_phase():
+    """(adaptive_breakaway, hybrid.handles), imported at a run's first prediction (once: an import
+    statement costs a µs a run)."""
+    from . import adaptive_breakaway
+    from .hybrid import handles
+    return adaptive_breakaway, handles
 
 
 @functools.cache

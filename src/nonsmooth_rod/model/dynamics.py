@@ -141,6 +141,10 @@ def _most_admissible_split(A, lam0, owners, modes, scene):
 
 # A contact's mode as the compiled mode solve reads it.
 MODE_CODES = {"open": 0, "stick": 1, "slip+": 2, "slip-": 3}
+# The rows of A a contact in each mode adds (its normal; a sticking one's tangent too), and a
+# planar body's freedoms (x, y, θ: Scene.n_dof).
+MODE_ROWS = {"open": 0, "stick": 2, "slip+": 1, "slip-": 1}
+DOF_PER_BODY = 3
 # What a mode's switches watch (ModeSystem's `watched`): a contact's gap, slip velocity, N,
 # T − μs N, T + μs N; det A.
 WATCH_CODES = {"gap": 0, "slip": 1, "normal": 2, "upper": 3, "lower": 4, "det": 5}
@@ -155,22 +159,27 @@ class ModeSystem:
     For a body's disks and points on fixed lines (the contacts the hybrid method runs) whose
     constrained system is regular; `evaluate` returns None elsewhere — a statically indeterminate
     A (two sticking corners of a block at rest), whose split mode_dynamics chooses — and the caller
-    falls back on mode_dynamics. `watched`: (what, contact, offset) triples, `what` a key of
-    WATCH_CODES; each value is the quantity minus the offset."""
+    falls back on mode_dynamics. `usable`: False where that is known from the modes alone (other
+    contacts; a body held by more rows than its freedoms, `indeterminate_everywhere`).
+    `watched`: (what, contact, offset) triples, `what` a key of WATCH_CODES; each value is the
+    quantity minus the offset."""
 
     def __init__(self, scene: Scene, modes, watched=(), like: ModeSystem | None = None):
         n, nc = scene.n_dof, len(scene.contacts)
         self.scene, self.n_dof = scene, n
         if like is None:  # the scene's packed contacts; `like`: another mode's system of this scene has them
             packed = [c._packed_row() for c in scene.contacts]
-            self.usable = all(kind == KIND_DISK_ON_LINE and c.obstacle_motion is None
-                              for (kind, _, _, _), c in zip(packed, scene.contacts))
+            self.contacts_usable = all(kind == KIND_DISK_ON_LINE and c.obstacle_motion is None
+                                       for (kind, _, _, _), c in zip(packed, scene.contacts))
             self.table = np.array([row for _, _, _, row in packed], dtype=float).reshape(nc, N_CONTACT_COLUMNS)
             self.table[:, C_MU_S] = [c.law.friction.mu_s for c in scene.contacts]
             self.table[:, C_MU_D] = [c.law.friction.mu_d for c in scene.contacts]
             self.bodies = [body for _, body, _, _ in packed]
         else:
-            self.usable, self.table, self.bodies = like.usable, like.table, like.bodies
+            self.contacts_usable, self.table, self.bodies = like.contacts_usable, like.table, like.bodies
+        # (a mode whose A is singular at every state is declined before any compiled call: a
+        # prediction of a statically indeterminate stick costs a dict lookup, not a mode solve)
+        self.usable = self.contacts_usable and not indeterminate_everywhere(self.bodies, modes)
         self.ints = np.array([(body, MODE_CODES[mode]) for body, mode in zip(self.bodies, modes)],
                              dtype=np.int64).reshape(nc, 2)
         self.watched = np.array([(WATCH_CODES[what], i) for what, i, _ in watched], dtype=np.int64).reshape(-1, 2)
@@ -178,7 +187,7 @@ class ModeSystem:
         self.minv = scene.inverse_mass_diagonal
         self.free = scene.inverse_mass_diagonal * scene.weight
         self.constant = not scene.forces and scene.applied_force is None
-        m, k = sum({"open": 0, "stick": 2}.get(mode, 1) for mode in modes), len(watched)
+        m, k = sum(MODE_ROWS[mode] for mode in modes), len(watched)
         # out's layout: ẏ = (v, a), the watched values, N, T, det A, A's rows
         self.rates, self.accelerations, self.values = slice(0, 2 * n), slice(n, 2 * n), slice(2 * n, 2 * n + k)
         self.normal, self.tangential = slice(2 * n + k, 2 * n + k + nc), slice(2 * n + k + nc, 2 * n + k + 2 * nc)
@@ -217,6 +226,17 @@ class ModeSystem:
         """The ModeDynamics of an evaluation."""
         return ModeDynamics(out[self.accelerations], out[self.normal], out[self.tangential],
                             out[self.matrix].reshape(self.m, self.m), False)
+
+
+def indeterminate_everywhere(bodies, modes) -> bool:
+    """Whether A is singular at every state: some body held by more rows (a closed contact's
+    normal, a sticking one's tangent too) than its 3 freedoms. A = C M⁻¹ Gᵀ, C's rows a body's
+    are functions of its 3 velocities: A's rank is at most 3 a body (its contacts are with fixed
+    lines: A has no entry between bodies), less than its rows — two sticking disks of a block."""
+    rows: dict = {}
+    for body, mode in zip(bodies, modes):
+        rows[body] = rows.get(body, 0) + MODE_ROWS[mode]
+    return any(m > DOF_PER_BODY for m in rows.values())
 
 
 @jit_inline  # into its one caller: a dispatcher of its own would optimise its code again there
