@@ -46,9 +46,10 @@ def test_simplex_agrees_with_highs_on_random_lps(compiled):
 @pytest.mark.parametrize("compiled", [True, False])
 def test_the_pivot_on_the_pivot_rows_non_zeros_has_the_bits_of_the_full_update(compiled):
     """_pivot updates only the columns where the pivot row is non-zero (a hold search's tableau is
-    mostly slack columns, zero in that row); elsewhere the full Gauss–Jordan update would subtract
-    an exact zero. So every entry must come out bit for bit as the full update's — the splits the
-    search chooses cannot move (a tableau with 80 % zeros, and columns zero but in the pivot row)."""
+    mostly slack columns, zero in that row), each as one axpy over the rows of a tableau stored by
+    columns; elsewhere the full Gauss–Jordan update would subtract an exact zero. So every entry
+    must come out bit for bit as the full row-wise update's — the splits the search chooses cannot
+    move (a tableau with 80 % zeros, and columns zero but in the pivot row)."""
     pivot = sticking._pivot if compiled else _interpreted(sticking._pivot)
     rng = np.random.default_rng(11)
     for _ in range(50):
@@ -63,9 +64,10 @@ def test_the_pivot_on_the_pivot_rows_non_zeros_has_the_bits_of_the_full_update(c
             if i != r:
                 expected[i, :] = expected[i, :] - expected[i, j] * expected[r, :]
         basis = np.zeros(m - 1, dtype=np.int64)
-        pivot(T, basis, r, j, np.empty(width, dtype=np.int64))
+        by_columns = np.ascontiguousarray(T.T)  # the layout simplex_tableau carves: [column, row]
+        pivot(by_columns, basis, r, j, np.empty(width, dtype=np.int64), np.empty(m))
         assert basis[r] == j
-        assert np.array_equal(T, expected)  # bits, not a tolerance
+        assert np.array_equal(by_columns.T, expected)  # bits, not a tolerance
 
 
 def _step_problem(toy, h=H):
