@@ -379,7 +379,7 @@ def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_
     return n
 
 
-@jit
+@jit_inline
 def _law_row(G, h, weight, n, rows, row, factor, divisor, value, row_weight):
     """Row n: G = factor · rows[row] / divisor (no product for a factor of 1), h = value / divisor."""
     for j in range(G.shape[1]):
