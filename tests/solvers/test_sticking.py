@@ -46,9 +46,10 @@ def test_simplex_agrees_with_highs_on_random_lps(compiled):
 @pytest.mark.parametrize("compiled", [True, False])
 def test_the_pivot_on_the_pivot_rows_non_zeros_has_the_bits_of_the_full_update(compiled):
     """_pivot updates only the columns where the pivot row is non-zero (a hold search's tableau is
-    mostly slack columns, zero in that row); elsewhere the full Gauss–Jordan update would subtract
-    an exact zero. So every entry must come out bit for bit as the full update's — the splits the
-    search chooses cannot move (a tableau with 80 % zeros, and columns zero but in the pivot row)."""
+    mostly slack columns, zero in that row), each as one axpy over the rows of a tableau stored by
+    columns; elsewhere the full Gauss–Jordan update would subtract an exact zero. So every entry
+    must come out bit for bit as the full row-wise update's — the splits the search chooses cannot
+    move (a tableau with 80 % zeros, and columns zero but in the pivot row)."""
     pivot = sticking._pivot if compiled else _interpreted(sticking._pivot)
     rng = np.random.default_rng(11)
     for _ in range(50):
@@ -63,9 +64,102 @@ def test_the_pivot_on_the_pivot_rows_non_zeros_has_the_bits_of_the_full_update(c
             if i != r:
                 expected[i, :] = expected[i, :] - expected[i, j] * expected[r, :]
         basis = np.zeros(m - 1, dtype=np.int64)
-        pivot(T, basis, r, j, np.empty(width, dtype=np.int64))
+        by_columns = np.ascontiguousarray(T.T)  # the layout simplex_tableau carves: [column, row]
+        pivot(by_columns, basis, r, j, np.empty(width, dtype=np.int64), np.empty(m))
         assert basis[r] == j
-        assert np.array_equal(T, expected)  # bits, not a tolerance
+        assert np.array_equal(by_columns.T, expected)  # bits, not a tolerance
+
+
+def _textbook_simplex(c, G, h):
+    """max cᵀx, G x ≤ h, x ≥ 0 on a row-major tableau, pivot by pivot as Dantzig's textbook tableau
+    with Bland's rule and simplex_max's phase 1 (one auxiliary column entered at the most violated
+    row): the reference the column-stored tableau must follow to the bit. Returns (status, x)."""
+    m, n = G.shape
+    T = np.zeros((m + 1, n + m + 2))
+    T[:m, :n], T[:m, n], T[:m, -1] = G, -1.0, h
+    T[np.arange(m), n + 1 + np.arange(m)] = 1.0
+    basis = list(range(n + 1, n + m + 1))
+
+    def pivot(r, j):
+        T[r] /= T[r, j]
+        for i in range(m + 1):
+            if i != r and T[i, j] != 0.0:
+                T[i] = T[i] - T[i, j] * T[r]
+        basis[r] = j
+
+    def objective(cost):
+        T[m] = np.r_[cost, 0.0]
+        for i in range(m):
+            if cost[basis[i]] != 0.0:
+                T[m] -= cost[basis[i]] * T[i]
+
+    def run():
+        for _ in range(50 * (n + m + 2)):
+            entering = [j for j in range(n + m + 1) if T[m, j] > sticking.PIVOT_TOL]
+            if not entering:
+                return 0
+            j, r = entering[0], -1
+            for i in range(m):
+                if T[i, j] > sticking.PIVOT_TOL:
+                    ratio = T[i, -1] / T[i, j]
+                    if r < 0 or ratio < best - 1e-14 or (ratio <= best + 1e-14 and basis[i] < basis[r]):
+                        best, r = ratio, i
+            if r < 0:
+                return 1
+            pivot(r, j)
+        return 2
+
+    cost = np.zeros(n + m + 1)
+    worst = int(np.argmin(h)) if m else 0
+    if m and h[worst] < 0.0:
+        cost[n] = -1.0
+        pivot(worst, n)
+        objective(cost)
+        if run() != 0 or -T[m, -1] < -1e-10 * (1.0 + np.max(np.abs(h))):
+            return 3, None
+        for i in range(m):
+            if basis[i] == n:
+                usable = [j for j in range(n + m + 1) if j != n and abs(T[i, j]) > sticking.PIVOT_TOL]
+                if usable:
+                    pivot(i, usable[0])
+        cost[n] = 0.0
+    T[:, n] = 0.0
+    cost[:n] = c
+    objective(cost)
+    status, x = run(), np.zeros(n)
+    for i in range(m):
+        if basis[i] < n:
+            x[basis[i]] = T[i, -1]
+    return status, x
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_column_stored_simplex_takes_the_textbook_pivots_to_the_bit(compiled):
+    """The hold search's tableau is stored by columns and each pivot updates only the pivot row's
+    non-zero columns (issue 26): its decisions rest on the exact vertex Bland's rule reaches (a
+    slip on its tolerance bound), so the same pivots must give the same bits as the textbook
+    row-wise tableau — on random LPs with degenerate vertices (zeros in h, repeated rows) and
+    infeasible and unbounded ones."""
+    solve = simplex_max if compiled else _interpreted(simplex_max)
+    rng = np.random.default_rng(5)
+    statuses = set()
+    for trial in range(150):
+        m, n = int(rng.integers(1, 9)), int(rng.integers(1, 7))
+        G = rng.normal(size=(m, n)) * (rng.random((m, n)) < 0.6)
+        h = rng.normal(size=m) * (rng.random(m) < 0.7)  # zeros: degenerate vertices
+        if m > 1 and trial % 4 == 0:
+            G[-1], h[-1] = G[0], h[0]  # a repeated row
+        if trial % 3 == 0:
+            G, h = np.vstack([G, np.eye(n)]), np.r_[h, np.full(n, 4.0)]
+        c = rng.normal(size=n)
+        x = np.zeros(n)
+        status = solve(c, G, h, x)
+        expected_status, expected_x = _textbook_simplex(c, G, h)
+        assert status == expected_status
+        if status != 3:
+            assert np.array_equal(x, expected_x)  # bits, not a tolerance
+        statuses.add(status)
+    assert statuses == {0, 1, 3}
 
 
 def _step_problem(toy, h=H):

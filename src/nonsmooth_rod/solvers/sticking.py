@@ -52,55 +52,61 @@ REUSE_TOL = 1e-3
 
 
 @jit
-def _pivot(T, basis, r, j, cols):
-    """Gauss–Jordan pivot of tableau T on (r, j): variable j enters the basis in row r. In place,
-    entry by entry: compiled, each row expression `T[i, :] -= c * T[r, :]` allocated its
-    temporary (a third of a hold search's cost), and the rank-one update that replaced it
-    (`np.outer`) a whole tableau per pivot. Only the columns where the pivot row is non-zero are
-    divided and updated (their indices gathered in `cols`, int64 scratch of T's width): elsewhere
-    the division leaves a zero and the update subtracts an exact zero, so the same products and
-    the same rounding as the full update — and a fraction of its work, the tableau's slack columns
-    being mostly zero in the pivot row (the hold search's LPs: ~95 × 125). Rows with T[i, j] = 0
-    are skipped."""
-    pivot = T[r, j]
+def _pivot(T, basis, r, j, cols, factors):
+    """Gauss–Jordan pivot of the tableau on (row r, column j): variable j enters the basis in row r.
+    T is stored by columns (T[column, row], simplex_tableau), in place. Only the columns where the
+    pivot row is non-zero are divided and updated (their indices gathered in `cols`, int64 scratch
+    of the tableau's width): elsewhere the division leaves a zero and the update subtracts an exact
+    zero. Each such column is one contiguous axpy over the rows, column −= (its pivot-row entry) ×
+    the pivot column saved before the update (`factors`, float scratch of the tableau's height; 0
+    at row r, which keeps its divided entry): the same product and difference for every entry as
+    the row-wise update — the same bits — but vectorised where the row-wise loop gathered 17
+    scattered columns from each of ~80 rows (the hold search's LPs: ~83 × 108, issue 26). A row
+    whose pivot-column entry is 0 subtracts an exact zero."""
+    pivot = T[j, r]
     n_cols = 0
-    for col in range(T.shape[1]):
-        if T[r, col] != 0.0:
-            T[r, col] /= pivot
+    for col in range(T.shape[0]):
+        if T[col, r] != 0.0:
+            T[col, r] /= pivot
             cols[n_cols] = col
             n_cols += 1
-    for i in range(T.shape[0]):
-        factor = T[i, j]
-        if i != r and factor != 0.0:
-            for k in range(n_cols):
-                T[i, cols[k]] -= factor * T[r, cols[k]]
+    height = T.shape[1]
+    for i in range(height):
+        factors[i] = T[j, i]
+    factors[r] = 0.0
+    for k in range(n_cols):  # indexed, not a view of the column: a view counts a reference (an atomic
+        col = cols[k]         # increment and decrement, a third of the pivot's time)
+        entry = T[col, r]
+        for i in range(height):
+            T[col, i] -= factors[i] * entry
     basis[r] = j
 
 
 @jit
 def _set_objective(T, basis, cost):
-    """Objective row of T: reduced costs cost_j − c_Bᵀ T[:, j] (last entry −objective value).
-    Entry by entry: the row expression allocated its temporary."""
-    m = T.shape[0] - 1
-    for col in range(T.shape[1]):
-        T[m, col] = cost[col] if col < cost.shape[0] else 0.0
+    """Objective row of the tableau (T by columns): reduced costs cost_j − c_Bᵀ T[:, j] (last entry
+    −objective value), subtracted row by row in the basis' order — only the rows whose basic
+    variable has a cost (one in phase 1, the margin's two in the hold search's phase 2)."""
+    m = T.shape[1] - 1
+    for col in range(T.shape[0]):
+        T[col, m] = cost[col] if col < cost.shape[0] else 0.0
     for i in range(m):
         cb = cost[basis[i]]
         if cb != 0.0:
-            for col in range(T.shape[1]):
-                T[m, col] -= cb * T[i, col]
+            for col in range(T.shape[0]):
+                T[col, m] -= cb * T[col, i]
 
 
 @jit
-def _run_simplex(T, basis, n_allowed, max_iter, cols):
-    """Maximise over the tableau with Bland's rule; columns ≥ n_allowed never enter.
+def _run_simplex(T, basis, n_allowed, max_iter, cols, factors):
+    """Maximise over the tableau (T by columns) with Bland's rule; columns ≥ n_allowed never enter.
     Returns 0 optimal, 1 unbounded, 2 iteration limit."""
-    m = T.shape[0] - 1
-    rhs = T.shape[1] - 1
+    m = T.shape[1] - 1
+    rhs = T.shape[0] - 1  # the right-hand side's column
     for _ in range(max_iter):
         j = -1
         for col in range(n_allowed):
-            if T[m, col] > PIVOT_TOL:
+            if T[col, m] > PIVOT_TOL:
                 j = col
                 break
         if j < 0:
@@ -108,21 +114,22 @@ def _run_simplex(T, basis, n_allowed, max_iter, cols):
         r = np.int64(-1)  # not a literal: numba would compile _pivot for the literal −1 too
         best = np.inf
         for i in range(m):
-            if T[i, j] > PIVOT_TOL:
-                ratio = T[i, rhs] / T[i, j]
+            if T[j, i] > PIVOT_TOL:
+                ratio = T[rhs, i] / T[j, i]
                 if ratio < best - 1e-14 or (ratio <= best + 1e-14 and r >= 0 and basis[i] < basis[r]):
                     best = ratio
                     r = i
         if r < 0:
             return 1
-        _pivot(T, basis, r, j, cols)
+        _pivot(T, basis, r, j, cols, factors)
     return 2
 
 
 @jit
 def simplex_floats(m, n):
-    """Floats simplex_in takes for m constraints on n unknowns: its tableau, cost row and c."""
-    return (m + 1) * (n + m + 2) + (n + m + 1) + n
+    """Floats simplex_in takes for m constraints on n unknowns: its tableau, cost row, c and the
+    pivot's saved column."""
+    return (m + 1) * (n + m + 2) + (n + m + 1) + n + (m + 1)
 
 
 @jit
@@ -133,20 +140,24 @@ def simplex_ints(m, n):
 
 @jit
 def simplex_tableau(floats, ints, m, n):
-    """(T, basis, cols, cost, c) carved from scratch (simplex_floats, simplex_ints) for m
-    constraints on n unknowns: T zero but for the phase-1 column (−1) and the slacks' identity,
-    every slack basic; the caller writes G, h (T[i, :n], T[i, −1]) and c."""
-    T, at = carve_matrix(floats, 0, m + 1, n + m + 2)
+    """(T, basis, cols, cost, c, factors) carved from scratch (simplex_floats, simplex_ints) for m
+    constraints on n unknowns. T is stored by columns — T[column, row], n + m + 2 columns (the
+    unknowns, the phase-1 column, the slacks, the right-hand side) of m + 1 rows (the constraints,
+    the objective) — so that a pivot updates whole contiguous columns (_pivot). T is zero but for
+    the phase-1 column (−1) and the slacks' identity, every slack basic; the caller writes G and h
+    (T[:n, i], T[−1, i] for constraint i) and c."""
+    T, at = carve_matrix(floats, 0, n + m + 2, m + 1)
     cost, at = carve(floats, at, n + m + 1)
     c, at = carve(floats, at, n)
+    factors, at = carve(floats, at, m + 1)
     basis, at_int = carve(ints, 0, m)
     cols, at_int = carve(ints, at_int, n + m + 2)
     T[:, :] = 0.0
     for i in range(m):
-        T[i, n] = -1.0
-        T[i, n + 1 + i] = 1.0
+        T[n, i] = -1.0
+        T[n + 1 + i, i] = 1.0
         basis[i] = n + 1 + i
-    return T, basis, cols, cost, c
+    return T, basis, cols, cost, c, factors
 
 
 @jit
@@ -158,49 +169,51 @@ def simplex_max(c, G, h, x):
     """
     m, n = G.shape
     floats, ints = np.empty(simplex_floats(m, n)), np.empty(simplex_ints(m, n), dtype=np.int64)
-    T, basis, cols, cost, c_in = simplex_tableau(floats, ints, m, n)
+    T, basis, cols, cost, c_in, factors = simplex_tableau(floats, ints, m, n)
     h_largest = 0.0
     for i in range(m):
-        T[i, :n] = G[i, :]
-        T[i, -1] = h[i]
+        for j in range(n):
+            T[j, i] = G[i, j]
+        T[n + m + 1, i] = h[i]
         h_largest = max(h_largest, abs(h[i]))
     c_in[:] = c
-    return simplex_in(T, basis, cols, cost, c_in, h_largest, x)
+    return simplex_in(T, basis, cols, cost, c_in, factors, h_largest, x)
 
 
 @jit
-def simplex_in(T, basis, cols, cost, c, h_largest, x):
-    """simplex_max on a tableau simplex_tableau carved and the caller filled with G and h
-    (h_largest: max |h|, for the phase-1 test). Allocates nothing."""
-    m = T.shape[0] - 1
+def simplex_in(T, basis, cols, cost, c, factors, h_largest, x):
+    """simplex_max on a tableau simplex_tableau carved (T by columns) and the caller filled with G
+    and h (h_largest: max |h|, for the phase-1 test). Allocates nothing."""
+    m = T.shape[1] - 1
     n = c.shape[0]
+    rhs = T[T.shape[0] - 1]
     max_iter = 50 * (n + m + 2)
     worst = np.int64(0)
     for i in range(m):
-        if T[i, -1] < T[worst, -1]:
+        if rhs[i] < rhs[worst]:
             worst = i
     cost[:] = 0.0
-    if m > 0 and T[worst, -1] < 0.0:
+    if m > 0 and rhs[worst] < 0.0:
         cost[n] = -1.0
-        _pivot(T, basis, worst, n, cols)
+        _pivot(T, basis, worst, n, cols, factors)
         _set_objective(T, basis, cost)
-        if _run_simplex(T, basis, n + m + 1, max_iter, cols) != 0 or -T[m, -1] < -1e-10 * (1.0 + h_largest):
+        if _run_simplex(T, basis, n + m + 1, max_iter, cols, factors) != 0 or -rhs[m] < -1e-10 * (1.0 + h_largest):
             return 3
         for i in range(m):
             if basis[i] == n:  # degenerate: x_a = 0 basic; swap it for any usable column
                 for j in range(n + m + 1):
-                    if j != n and abs(T[i, j]) > PIVOT_TOL:
-                        _pivot(T, basis, i, j, cols)
+                    if j != n and abs(T[j, i]) > PIVOT_TOL:
+                        _pivot(T, basis, i, j, cols, factors)
                         break
         cost[n] = 0.0
-    T[:, n] = 0.0  # the auxiliary variable is done with (or was never needed)
+    T[n, :] = 0.0  # the auxiliary variable is done with (or was never needed)
     cost[:n] = c
     _set_objective(T, basis, cost)
-    status = _run_simplex(T, basis, n + m + 1, max_iter, cols)
+    status = _run_simplex(T, basis, n + m + 1, max_iter, cols, factors)
     x[:] = 0.0
     for i in range(m):
         if basis[i] < n:
-            x[basis[i]] = T[i, -1]
+            x[basis[i]] = rhs[i]
     return status
 
 
@@ -366,7 +379,7 @@ def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_
     return n
 
 
-@jit
+@jit_inline
 def _law_row(G, h, weight, n, rows, row, factor, divisor, value, row_weight):
     """Row n: G = factor · rows[row] / divisor (no product for a factor of 1), h = value / divisor."""
     for j in range(G.shape[1]):
@@ -403,29 +416,30 @@ def _deepest_split(G, h, weight, z, floats, ints):
     n = 2 * k + 2  # z = z⁺ − z⁻, t = t⁺ − t⁻
     rows = m + 2 * k + 1
     floats, ints = lp_scratch(floats, ints, rows, n)
-    T, basis, cols, cost, c = simplex_tableau(floats, ints, rows, n)
+    T, basis, cols, cost, c, factors = simplex_tableau(floats, ints, rows, n)  # T[column, row]
+    rhs = T[n + rows + 1]
     h_largest = max(SPLIT_BOUND, 1.0)
     for r in range(m):  # −g·z + weight·t ≤ g0
         for j in range(k):
-            T[r, j] = -G[r, j]
-            T[r, k + j] = G[r, j]
-        T[r, 2 * k] = weight[r]
-        T[r, 2 * k + 1] = -weight[r]
-        T[r, -1] = h[r]
+            T[j, r] = -G[r, j]
+            T[k + j, r] = G[r, j]
+        T[2 * k, r] = weight[r]
+        T[2 * k + 1, r] = -weight[r]
+        rhs[r] = h[r]
         h_largest = max(h_largest, abs(h[r]))
     for j in range(k):  # |z_j| ≤ SPLIT_BOUND: z⁺_j, z⁻_j ≤ SPLIT_BOUND
-        T[m + 2 * j, j] = 1.0
-        T[m + 2 * j + 1, k + j] = 1.0
-        T[m + 2 * j, -1] = SPLIT_BOUND
-        T[m + 2 * j + 1, -1] = SPLIT_BOUND
-    T[m + 2 * k, 2 * k] = 1.0  # t ≤ 1
-    T[m + 2 * k, 2 * k + 1] = -1.0
-    T[m + 2 * k, -1] = 1.0
+        T[j, m + 2 * j] = 1.0
+        T[k + j, m + 2 * j + 1] = 1.0
+        rhs[m + 2 * j] = SPLIT_BOUND
+        rhs[m + 2 * j + 1] = SPLIT_BOUND
+    T[2 * k, m + 2 * k] = 1.0  # t ≤ 1
+    T[2 * k + 1, m + 2 * k] = -1.0
+    rhs[m + 2 * k] = 1.0
     c[:] = 0.0
     c[2 * k] = 1.0
     c[2 * k + 1] = -1.0
     x, _ = carve(floats, simplex_floats(rows, n), n)
-    if simplex_in(T, basis, cols, cost, c, h_largest, x) != 0:
+    if simplex_in(T, basis, cols, cost, c, factors, h_largest, x) != 0:
         return -np.inf
     for j in range(k):
         z[j] = x[j] - x[k + j]
