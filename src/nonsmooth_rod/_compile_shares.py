@@ -1,7 +1,10 @@
 """The compiled loop's callees, compiled on two cores before it (`_compile_split`): the job's
 share, then the helper's. Each: module, function, the argument types the loop's typing asks
 for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engine/
-test_compile_split.py checks it against the loop)."""
+test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
+not the sources' key: _loop_callees.sources_key)."""
+
+SOURCES = '5f0f3ffe3a7e57954dfdcb738b4251f1'
 
 SHARES = (
     (

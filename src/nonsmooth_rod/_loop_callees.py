@@ -127,15 +127,33 @@ def signature_text(args) -> str | None:
     return text if read_back == tuple(args) else None
 
 
-def shares_source(callees) -> str:
-    """_compile_shares.py's text: this process's share, then the helper's (HELPER_SHARE); the
-    callees whose signature has no text are left out (compiled with the chain)."""
+def sources_key(root: Path | None = None) -> str:
+    """What the shares are written from: a digest of every source of the package but the shares
+    file itself (the loop's code, its callees, and the Python that builds its arguments) and the
+    numba version that types them. While a shipped file's key is this key, typing the loop again
+    can only give the file back."""
+    import hashlib
+
+    import numba
+
+    root = SHARES_FILE.parent if root is None else root
+    digest = hashlib.blake2b(numba.__version__.encode(), digest_size=16)
+    for path in sorted(p for p in root.rglob("*.py") if p.name != SHARES_FILE.name):
+        digest.update(str(path.relative_to(root)).encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def shares_source(callees, key: str) -> str:
+    """_compile_shares.py's text: the sources' key, this process's share, then the helper's
+    (HELPER_SHARE); the callees whose signature has no text are left out (compiled with the chain)."""
     callees = [(module, name, args) for module, name, args in callees if signature_text(args) is not None]
     shares = ([c for c in callees if c[1] not in HELPER_SHARE], [c for c in callees if c[1] in HELPER_SHARE])
     lines = ['"""The compiled loop\'s callees, compiled on two cores before it (`_compile_split`): the job\'s',
              "share, then the helper's. Each: module, function, the argument types the loop's typing asks",
              "for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engine/",
-             'test_compile_split.py checks it against the loop)."""', "", "SHARES = ("]
+             'test_compile_split.py checks it against the loop, typing the loop again when SOURCES is',
+             'not the sources\' key: _loop_callees.sources_key)."""', "", f"SOURCES = {key!r}", "", "SHARES = ("]
     for share in shares:
         lines.append("    (")
         for module, name, args in share:
@@ -158,7 +176,7 @@ def entry_args():
 def write_shares() -> None:
     from .io import write_text
 
-    write_text(SHARES_FILE, shares_source(loop_callees(entry_args())))
+    write_text(SHARES_FILE, shares_source(loop_callees(entry_args()), sources_key()))
     print(f"wrote {SHARES_FILE}")
 
 
