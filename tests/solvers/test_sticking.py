@@ -663,14 +663,15 @@ def _law_ratio(W, q, mode, sign, mu_s, p, tol, scale):
 def test_pruning_lps_on_the_shared_relaxation_decide_as_the_general_ones(compiled):
     """A pruning LP solved on the relaxation factored once per search (_pruning_split: the LP's
     equations are the relaxation's and the held candidate's 1–2 rows) decides as admissible_split on
-    the same mode, or — the deepest split being a vertex of a face of optima, found in another basis
-    — both splits sit on the final check's boundary: their largest law quantity within 1e-3 of its
-    tolerance (a sliding contact's slip on the LP's hard bound, issue 26). Every pruning LP of
+    the same mode. Its deepest split is a vertex of a face of optima found in another basis, often
+    with a sliding contact's slip on the LP's hard bound; that bound keeps LP_SHARE of the final
+    check's tolerance, so every optimal vertex passes the check and the two decide alike (with the
+    bound at the tolerance itself, before issue 26, round-off split them). Every pruning LP of
     small row clusters; the shared path must vouch for most of them."""
     def kernel(name):
         return getattr(sticking, name) if compiled else _interpreted(getattr(sticking, name))
     rng = np.random.default_rng(27)
-    vouched = declined = agreed = 0
+    vouched = declined = admissible = 0
     for _ in range(12 if compiled else 4):
         W, q, mu_s, mu_d, p, u, states, tol, scale, candidates, release, n_c, mode, sign = _search_start(kernel, rng)
         na = len(mu_s)
@@ -687,12 +688,9 @@ def test_pruning_lps_on_the_shared_relaxation_decide_as_the_general_ones(compile
                 declined += 1
                 continue
             vouched += 1
-            if found == int(expected):
-                agreed += 1
-                continue
-            for split in (p_shared, p_general):  # both on the check's boundary
-                assert abs(_law_ratio(W, q, mode, sign, mu_s, split, tol, scale) - 1.0) <= 1e-3
-    assert vouched > 20 and agreed >= 0.8 * vouched and vouched >= 4 * declined
+            assert found == int(expected)
+            admissible += bool(expected)
+    assert vouched > 20 and admissible >= 5 and vouched >= 4 * declined
 
 
 @pytest.mark.parametrize("compiled", [True, False])
