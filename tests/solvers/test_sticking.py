@@ -141,9 +141,8 @@ def _textbook_simplex(c, G, h):
 @pytest.mark.parametrize("compiled", [True, False])
 def test_the_column_stored_simplex_takes_the_textbook_pivots_to_the_bit(compiled):
     """The hold search's tableau is stored by columns and each pivot updates only the pivot row's
-    non-zero columns (issue 26): its decisions rest on the exact vertex Bland's rule reaches (a
-    slip on its tolerance bound), so the same pivots must give the same bits as the textbook
-    row-wise tableau — on random LPs with degenerate vertices (zeros in h, repeated rows) and
+    non-zero columns (issue 26): the same pivots (Dantzig's rule, Bland's after a degenerate pivot)
+    must give the same bits as the textbook row-wise tableau — on random LPs with degenerate vertices (zeros in h, repeated rows) and
     infeasible and unbounded ones."""
     solve = simplex_max if compiled else _interpreted(simplex_max)
     rng = np.random.default_rng(5)
