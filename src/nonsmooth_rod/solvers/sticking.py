@@ -44,8 +44,14 @@ MAX_TRIALS = 64  # feasibility problems per step at most
 BORDER_MAX = 2 * MAX_CANDIDATES  # entries a held-set trial adds to its base (two per candidate that lifts)
 SPLIT_BOUND = 1e3  # |z| ≤ SPLIT_BOUND × the impulse scale, as the event-driven LP
 PIVOT_TOL = 1e-11
+DEGENERATE = 1e-14  # a pivot whose ratio is below this moves no vertex (the ratio test's tie width)
 RANK_TOL = 1e-10  # singular values below RANK_TOL × the largest span the indeterminate splits
 MARGIN_TOL = 1e-9  # a cone margin above −MARGIN_TOL × the impulse scale is admissible
+# The LP keeps its hard rows (a slip direction, an open or loose contact's u_N) and its margin
+# within LP_SHARE of the final check's tolerances (_split_obeys_law), so that every optimal vertex
+# of the LP — whichever one the pivot rule returns — passes that check by the rest: the decision
+# is the LP's optimum's, never round-off's (docs/solvers.md, "A decision round-off cannot flip").
+LP_SHARE = 0.5
 # The previous step's split is reused when it leaves velocities below REUSE_TOL × the slip
 # tolerance (round-off: 1e-12 |q|), so that a held body does not creep at the tolerance.
 REUSE_TOL = 1e-3
@@ -99,16 +105,25 @@ def _set_objective(T, basis, cost):
 
 @jit
 def _run_simplex(T, basis, n_allowed, max_iter, cols, factors):
-    """Maximise over the tableau (T by columns) with Bland's rule; columns ≥ n_allowed never enter.
-    Returns 0 optimal, 1 unbounded, 2 iteration limit."""
+    """Maximise over the tableau (T by columns); columns ≥ n_allowed never enter. The entering
+    column is Dantzig's (the largest reduced cost: about half the pivots of Bland's on the hold
+    search's LPs, issue 26) except after a degenerate pivot (the ratio ≤ DEGENERATE), where it is
+    Bland's (the lowest index) until the objective moves again: a cycle is made of degenerate pivots
+    only, so each of its pivots would follow a degenerate one and be Bland's, which never cycles
+    (from any basis). The leaving row: the least
+    ratio, ties to the lowest basic index. Returns 0 optimal, 1 unbounded, 2 iteration limit."""
     m = T.shape[1] - 1
     rhs = T.shape[0] - 1  # the right-hand side's column
+    bland = False
     for _ in range(max_iter):
         j = -1
+        largest = PIVOT_TOL
         for col in range(n_allowed):
-            if T[col, m] > PIVOT_TOL:
+            if T[col, m] > largest:
                 j = col
-                break
+                if bland:
+                    break
+                largest = T[col, m]
         if j < 0:
             return 0
         r = np.int64(-1)  # not a literal: numba would compile _pivot for the literal −1 too
@@ -122,6 +137,7 @@ def _run_simplex(T, basis, n_allowed, max_iter, cols, factors):
         if r < 0:
             return 1
         _pivot(T, basis, r, j, cols, factors)
+        bland = best <= DEGENERATE
     return 2
 
 
@@ -162,7 +178,8 @@ def simplex_tableau(floats, ints, m, n):
 
 @jit
 def simplex_max(c, G, h, x):
-    """max cᵀx subject to G x ≤ h, x ≥ 0 (dense two-phase simplex, Bland's rule).
+    """max cᵀx subject to G x ≤ h, x ≥ 0 (dense two-phase simplex, Dantzig's rule, Bland's after a
+    degenerate pivot: _run_simplex).
 
     Phase 1 adds one auxiliary variable x_a (G x − x_a ≤ h, max −x_a) entered at the most
     violated row. Fills x; returns 0 optimal, 1 unbounded, 2 iteration limit, 3 infeasible.
@@ -345,7 +362,8 @@ def _particular_and_null(A, b):
 def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_tol, scale, G, h, weight):
     """Rows (G, h, weight) of  g0 + g·z ≥ weight·t  for every law the split must keep, in
     impulse units divided by `scale`: p_N ≥ t and μs p_N ∓ p_T ≥ t (weight 1, the margins);
-    slip direction kept s u_T ≥ −tol and open contacts u_N ≥ −tol (weight 0, hard). u0 = W p0 + q,
+    slip direction kept s u_T ≥ −tol/2 and open contacts u_N ≥ −tol/2 (weight 0, hard: LP_SHARE of
+    the final check's tolerance, which an optimal vertex may sit on). u0 = W p0 + q,
     Wz = W Pz, w_scale = max |W|; written into G, h, weight (4 rows per contact at most), and
     returns how many rows."""
     na = mode.shape[0]
@@ -353,14 +371,14 @@ def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_
     n = 0
     for i in range(na):
         if mode[i] == MODE_OPEN:  # velocities in impulse units: divided by max|W|
-            _law_row(G, h, weight, n, Wz, 2 * i, 1.0, w_scale, u0[2 * i] + velocity_tol, 0.0)
+            _law_row(G, h, weight, n, Wz, 2 * i, 1.0, w_scale, u0[2 * i] + LP_SHARE * velocity_tol, 0.0)
             n += 1
             continue
         _law_row(G, h, weight, n, Pz, 2 * i, 1.0, 1.0, p0[2 * i], 1.0)
         n += 1
         if mode[i] == MODE_LOOSE:  # u_N ≥ −tol/2 in place of u_N = 0 (the margin pushes it to the
-            # bound: half, so that round-off stays within the final check's)
-            _law_row(G, h, weight, n, Wz, 2 * i, 1.0, w_scale, u0[2 * i] + 0.5 * velocity_tol, 0.0)
+            # bound: LP_SHARE of it, so that round-off stays within the final check's)
+            _law_row(G, h, weight, n, Wz, 2 * i, 1.0, w_scale, u0[2 * i] + LP_SHARE * velocity_tol, 0.0)
             n += 1
         if mode[i] == MODE_STICK or mode[i] == MODE_FREE or mode[i] == MODE_LOOSE:
             for side in (-1.0, 1.0):
@@ -370,7 +388,8 @@ def _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_
                 weight[n] = 1.0
                 n += 1
         else:
-            _law_row(G, h, weight, n, Wz, 2 * i + 1, sign[i], w_scale, sign[i] * u0[2 * i + 1] + velocity_tol, 0.0)
+            _law_row(G, h, weight, n, Wz, 2 * i + 1, sign[i], w_scale,
+                     sign[i] * u0[2 * i + 1] + LP_SHARE * velocity_tol, 0.0)
             n += 1
     for r in range(n):
         for j in range(k):
@@ -555,7 +574,7 @@ def _deepest_admissible(W, q, mu_s, mode, sign, p0, Pz, velocity_tol, scale, p_o
         np.dot(W, Pz, Wz)
     n = _admissible_constraints(u0, Wz, w_scale, mode, sign, mu_s, p0, Pz, velocity_tol, scale, G, h, weight)
     margin = _deepest_split(G[:n], h[:n], weight[:n], z, floats[at:], ints)
-    if margin < -MARGIN_TOL:
+    if margin < -LP_SHARE * MARGIN_TOL:
         return False
     if k == 0:  # the split is p0 itself, and u = W p0 + q is u0 (bit for bit: p0 + 0 is p0)
         for i in range(m2):
