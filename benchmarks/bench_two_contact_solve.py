@@ -61,11 +61,13 @@ def two_contact_problems(toy):
     return np.array(Ws), np.array(qs), np.array(los), np.array(his)
 
 
-def _solve_many(code, Ws, qs, los, his, reps, p, u, floats, ints):
+def _solve_many(code, Ws, qs, los, his, reps, p, u, floats, ints, rtol, max_iter):
+    # rtol, max_iter passed in, not written here: a literal 0 would make numba compile the loop's
+    # solve_interval_into (and its solvers) once more for Literal[int](0) instead of loading its code
     total = 0.0
     for _ in range(reps):
         for k in range(Ws.shape[0]):
-            solve_interval_into(code, Ws[k], qs[k], los[k], his[k], p, u, 0.0, 0, floats, ints)
+            solve_interval_into(code, Ws[k], qs[k], los[k], his[k], p, u, rtol, max_iter, floats, ints)
             total += p[0]
     return total
 
@@ -81,11 +83,11 @@ def solve_us(code, problems, reps, rounds):
     Ws, qs, los, his = problems
     p, u = np.zeros(4), np.zeros(4)
     floats, ints = np.zeros(4096), np.zeros(512, dtype=np.int64)
-    _solve_many(code, Ws, qs, los, his, 1, p, u, floats, ints)  # compile, warm
+    _solve_many(code, Ws, qs, los, his, 1, p, u, floats, ints, 0.0, 0)  # compile, warm
     times = []
     for _ in range(rounds):
         t0 = time.process_time()
-        _solve_many(code, Ws, qs, los, his, reps, p, u, floats, ints)
+        _solve_many(code, Ws, qs, los, his, reps, p, u, floats, ints, 0.0, 0)
         times.append((time.process_time() - t0) / (reps * Ws.shape[0]) * 1e6)
     return statistics.median(times)
 

@@ -96,7 +96,7 @@ def test_the_purged_folders_are_where_numba_caches_the_kernels():
     from nonsmooth_rod.integrators import moreau_jean_loop
     from nonsmooth_rod.solvers import lemke
 
-    for module, kernel in ((moreau_jean_loop, moreau_jean_loop.run_steps), (lemke, lemke._lemke_friction_kernel)):
+    for module, kernel in ((moreau_jean_loop, moreau_jean_loop.run_steps), (lemke, lemke._lemke_friction_into)):
         assert Path(kernel._cache._cache_path) == _jit._cache_dir_of(Path(module.__file__))
 
 

@@ -17,6 +17,9 @@ from nonsmooth_rod.solvers.kernels import (
     dense_to_blocks,
     pgs_block,
     solve_interval,
+    solve_interval_into,
+    solver_floats,
+    solver_ints,
 )
 from nonsmooth_rod.solvers.lemke import HAVE_NUMBA, lemke_friction
 from nonsmooth_rod.solvers.problem import PlanarFrictionProblem, complementarity_residual, residual_scale
@@ -128,7 +131,12 @@ def test_pgs_block_equals_pgs_on_the_dense_matrix():
 def test_compiled_and_interpreted_kernels_agree(code):
     """Same source both ways: the same status and iterations, p to a few hundred ulps."""
     rng = np.random.default_rng(11)
-    python_kernel = interpreted(solve_interval)
+    into = interpreted(solve_interval_into)  # (solve_interval runs the compiled one, its scratch made in Python)
+
+    def python_kernel(code, W, q, lo, hi, p, u, rtol, max_iter):
+        n = lo.shape[0]
+        return into(code, W, q, lo, hi, p, u, rtol, max_iter, np.empty(solver_floats(n)),
+                    np.empty(solver_ints(n), dtype=np.int64))
     for k in range(20):
         problem = random_step(rng, 1 + k % 2, kind=("disk", "corner")[k % 2])
         compiled = run(code, problem)

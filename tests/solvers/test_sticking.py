@@ -19,6 +19,16 @@ def _interpreted(function):
     return getattr(function, "py_func", function)
 
 
+# the inlined kernels (_jit.jit_inline: no dispatcher of their own in the loop): run as their bodies,
+# their callees compiled — compiled on their own they would compile their callees' subtree again
+_INLINED = ("_bordered_trials", "_bordered_split", "_relaxed_base", "_pruning_split")
+
+
+def _compiled_or_body(name, compiled):
+    function = getattr(sticking, name)
+    return function if compiled and name not in _INLINED else _interpreted(function)
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 def test_simplex_agrees_with_highs_on_random_lps(compiled):
     solve = simplex_max if compiled else _interpreted(simplex_max)
@@ -184,9 +194,8 @@ def _free_fall(q):
     return np.zeros_like(q), q.copy(), np.full(len(q) // 2, STATE_OPEN, dtype=np.int64)
 
 
-@pytest.mark.parametrize("compiled", [True, False])
-def test_wedged_rod_is_held_when_some_split_can_hold_it(compiled):
-    run = prefer_sticking if compiled else _interpreted(prefer_sticking)
+def test_wedged_rod_is_held_when_some_split_can_hold_it():
+    run = prefer_sticking
     toy = WedgedRod(angle=math.radians(30.0), mu_s=0.7, mu_d=0.5)
     W, q = _step_problem(toy)
     p, u, states = _free_fall(q)
@@ -320,11 +329,11 @@ def test_coupled_components_dense_and_block_sparse(compiled):
                 assert (dense[i] == dense[j]) == bool(reach[i, j])
 
 
-@pytest.mark.parametrize("compiled", [True, False])
-def test_each_group_is_held_alone_as_if_it_were_the_whole_step(compiled):
+def test_each_group_is_held_alone_as_if_it_were_the_whole_step():
+    from nonsmooth_rod.solvers._common import python_body
     from nonsmooth_rod.solvers.sticking import prefer_sticking_by_group
 
-    run = prefer_sticking_by_group if compiled else _interpreted(prefer_sticking_by_group)
+    run = python_body(prefer_sticking_by_group)  # (the loop's compiled kernels; it exists only inlined)
     W, q, mu_s, mu_d, (W1, q1) = _two_wedged_rods()
     p, u, states = _free_fall(q)
     tol = 1e-9 * np.max(np.abs(q))
@@ -344,11 +353,10 @@ def test_each_group_is_held_alone_as_if_it_were_the_whole_step(compiled):
     assert np.all(p == 0.0)
 
 
-@pytest.mark.parametrize("compiled", [True, False])
-def test_candidates_no_split_can_hold_are_pruned_and_the_others_still_held(compiled):
+def test_candidates_no_split_can_hold_are_pruned_and_the_others_still_held():
     """One problem, four candidates (both rods' wall contacts slide from rest): the falling rod's
     two are pruned (not holdable even with every other candidate free), the holdable rod is held."""
-    run = prefer_sticking if compiled else _interpreted(prefer_sticking)
+    run = prefer_sticking
     W, q, mu_s, mu_d, (W1, q1) = _two_wedged_rods()
     p, u, states = _free_fall(q)
     tol = 1e-9 * np.max(np.abs(q))
@@ -506,14 +514,13 @@ def test_the_split_margin_without_unknowns_is_the_simplex_optimum():
     assert 0 < infeasible < 300
 
 
-@pytest.mark.parametrize("compiled", [True, False])
-def test_the_least_squares_without_svd_vouches_only_for_full_rank(compiled):
+def test_the_least_squares_without_svd_vouches_only_for_full_rank():
     """_full_row_rank_solution (a QR and a triangular inverse in place of LAPACK's SVD, one per LP of
     the hold search) certifies A's full row rank at RANK_TOL only when the SVD would find it: then
     x0 is the minimum-norm solution and Z an orthonormal basis of A's null space; a rank-deficient
     or nearly so A (the SVD's rank below m) is never certified — the caller takes the SVD."""
     from nonsmooth_rod.solvers import sticking
-    solve = sticking._full_row_rank_solution if compiled else _interpreted(sticking._full_row_rank_solution)
+    solve = _interpreted(sticking._full_row_rank_solution)  # (inlined: its callees run compiled)
     rng = np.random.default_rng(3)
     certified = deficient = 0
     for trial in range(300):
@@ -581,7 +588,7 @@ def test_held_set_trials_through_the_shared_factorization_are_the_general_ones(c
     a trial whose mode leaves freedom in the split is never vouched for (the general LP takes it).
     Every trial of small row clusters (issue 26: the row of 16's held-set trials, 143 LPs)."""
     def kernel(name):
-        return getattr(sticking, name) if compiled else _interpreted(getattr(sticking, name))
+        return _compiled_or_body(name, compiled)
     rng = np.random.default_rng(26)
     vouched = declined = admissible = 0
     for _ in range(12 if compiled else 4):
@@ -668,7 +675,7 @@ def test_pruning_lps_on_the_shared_relaxation_decide_as_the_general_ones(compile
     bound at the tolerance itself, before issue 26, round-off split them). Every pruning LP of
     small row clusters; the shared path must vouch for most of them."""
     def kernel(name):
-        return getattr(sticking, name) if compiled else _interpreted(getattr(sticking, name))
+        return _compiled_or_body(name, compiled)
     rng = np.random.default_rng(27)
     vouched = declined = admissible = 0
     for _ in range(12 if compiled else 4):

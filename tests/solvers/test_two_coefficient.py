@@ -11,16 +11,13 @@ from nonsmooth_rod.model.body import RigidBody
 from nonsmooth_rod.model.contacts import Line, PointOnLine
 from nonsmooth_rod.model.laws import ContactLaw
 from nonsmooth_rod.model.scene import Scene
+from nonsmooth_rod.solvers._common import python_body
 from nonsmooth_rod.solvers.kernels import KERNEL_SOLVED, SOLVER_CODES, solver_scratch
 from nonsmooth_rod.solvers.two_coefficient import (GROUP_MIN_CONTACTS, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,
                                                    two_coefficient_by_group, two_coefficient_kernel)
 from solver_cases import block_on_incline
 
 G = 9.81
-
-
-def _interpreted(function):
-    return getattr(function, "py_func", function)
 
 
 def _three_blocks():
@@ -35,10 +32,9 @@ def _three_blocks():
     return W, q, mu_s, 0.8 * mu_s, parts
 
 
-@pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("solver", ["lemke", "enum"])
-def test_each_group_gets_the_answer_it_gets_alone(solver, compiled):
-    by_group = two_coefficient_by_group if compiled else _interpreted(two_coefficient_by_group)
+def test_each_group_gets_the_answer_it_gets_alone(solver):
+    by_group = python_body(two_coefficient_by_group)  # (the loop's compiled kernels; it exists only inlined)
     W, q, mu_s, mu_d, parts = _three_blocks()
     assert len(mu_s) > GROUP_MIN_CONTACTS
     n = len(mu_s)

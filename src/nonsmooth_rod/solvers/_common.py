@@ -81,3 +81,24 @@ def interpreted(function):
             if getattr(value, "py_func", None) is not None and callable(value):
                 namespace[name] = interpreted(value)
     return twin
+
+
+# ---------------------------------------------------------------- one compiled entry per kernel
+# numba compiles a dispatcher's whole call subtree into its own machine code, once per argument
+# type signature: a compiled wrapper that allocates and calls an `_into` kernel, or the kernel
+# called with a readonly, strided or other-dtype array, compiles that subtree again (seconds).
+# So Python calls the very kernels the compiled loop calls, with the loop's argument types, and
+# loads the loop's cached code (docs/performance.md, "One compiled entry per kernel").
+
+def loop_array(values, dtype=np.float64) -> np.ndarray:
+    """`values` as the compiled loop passes its arrays: C-contiguous, writable, float64 (int64 for
+    dtype=np.int64). An array already so is returned itself (an output filled in place stays the
+    caller's); a readonly, strided or other-dtype one is copied."""
+    return np.require(values, dtype=dtype, requirements=["C", "W"])
+
+
+def python_body(kernel):
+    """A `_jit.jit_inline` kernel's Python source with the kernels it calls still compiled: how
+    Python runs a kernel that exists only inlined into its compiled callers (compiled on its own
+    it would compile its callees' subtree again). The function itself without numba."""
+    return getattr(kernel, "py_func", kernel)

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit, jit_borrowing, jit_inline
-from ._common import make_solution, require_finite_array
+from ._common import loop_array, make_solution, python_body, require_finite_array
 from ..validation import InputError
 from .kernel_base import (
     DEFAULT_RTOL,
@@ -183,11 +183,13 @@ def _unsolved(q, p, u):
         p[i], u[i] = 0.0, q[i]
 
 
-@jit
 def pgs_block(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps):
-    """pgs_block_into with scratch of its own (callers outside the step)."""
+    """pgs_block_into with scratch of its own, allocated here (callers outside the step): the loop's
+    compiled kernel with the loop's argument types (_common.loop_array; p, u filled in place)."""
     floats, ints = np.empty(PGS_FLOATS), np.empty(max(indptr.shape[0] - 1, 0), dtype=np.int64)
-    return pgs_block_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_sweeps, floats, ints)
+    return pgs_block_into(loop_array(indptr, np.int64), loop_array(indices, np.int64), loop_array(blocks),
+                          loop_array(q), loop_array(lo), loop_array(hi), p, u, float(rtol), int(max_sweeps), floats,
+                          ints)
 
 
 @jit_borrowing
@@ -350,12 +352,14 @@ def pgs_dense_ints(n_contacts):
     return n_contacts * n_contacts + 2 * n_contacts + 1
 
 
-@jit
 def pgs_dense(W, q, lo, hi, p, u, rtol, max_sweeps):
-    """pgs_dense_into with scratch of its own (callers outside the step)."""
+    """pgs_dense_into with scratch of its own, allocated here (callers outside the step): the loop's
+    compiled kernel with the loop's argument types (_common.loop_array; p, u filled in place)."""
     na = lo.shape[0]
-    floats, ints = np.empty(pgs_dense_floats(na)), np.empty(pgs_dense_ints(na), dtype=np.int64)
-    return pgs_dense_into(W, q, lo, hi, p, u, rtol, max_sweeps, floats, ints)
+    floats = np.empty(pgs_dense_floats(na))
+    ints = np.empty(python_body(pgs_dense_ints)(na), dtype=np.int64)
+    return pgs_dense_into(loop_array(W), loop_array(q), loop_array(lo), loop_array(hi), p, u, float(rtol),
+                          int(max_sweeps), floats, ints)
 
 
 @jit_borrowing

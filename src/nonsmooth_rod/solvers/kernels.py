@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit, jit_borrowing, jit_inline
+from ._common import loop_array
 from .enumeration import enum_interval
 from .delassus import dense_to_blocks
 from .gauss_seidel import pgs_block, pgs_block_into, pgs_dense, pgs_dense_into
@@ -163,11 +164,14 @@ def solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats,
     return KERNEL_NO_CONVERGENCE, 0, np.inf
 
 
-@jit
 def solve_interval(solver_code, W, q, lo, hi, p, u, rtol, max_iter):
-    """solve_interval_into with scratch of its own (Lemke's and pgs's; enum needs none)."""
-    floats, ints = solver_scratch(lo.shape[0] if solver_code != SOLVER_ENUM else 0)
-    return solve_interval_into(solver_code, W, q, lo, hi, p, u, rtol, max_iter, floats, ints)
+    """solve_interval_into with scratch of its own (Lemke's and pgs's; enum needs none), allocated
+    here: Python runs the loop's compiled dispatch with the loop's argument types
+    (_common.loop_array; p, u are filled in place: the caller's float64 arrays)."""
+    na = lo.shape[0] if solver_code != SOLVER_ENUM else 0
+    return solve_interval_into(int(solver_code), loop_array(W), loop_array(q), loop_array(lo), loop_array(hi), p, u,
+                               float(rtol), int(max_iter), np.empty(solver_floats(na)),
+                               np.empty(solver_ints(na), dtype=np.int64))
 
 
 __all__ = [

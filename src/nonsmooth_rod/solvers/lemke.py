@@ -53,8 +53,9 @@ import numpy as np
 from .._jit import ENABLED as HAVE_NUMBA, jit_inline
 from .._jit import jit, jit_borrowing, jit_inline
 from ..validation import InputError, quoted, require_integer, require_positive
-from ._common import RESIDUAL_FLOOR, interpreted, require_finite_array
-from .kernel_base import carve, carve_matrix, lu_factor, lu_solve, problem_scale, solver_scratch, step_residual
+from ._common import RESIDUAL_FLOOR, interpreted, loop_array, require_finite_array
+from .kernel_base import (carve, carve_matrix, lu_factor, lu_solve, problem_scale, solver_floats, solver_ints,
+                          step_residual)
 from .problem import (
     ContactSolution,
     NoConvergence,
@@ -375,16 +376,6 @@ def _scaled_step(W, q, d, Ws, qs):
             Ws[i][j] = W[i][j] * d[i // 2] * d[j // 2]
             ws_norm = max(ws_norm, abs(Ws[i][j]))
     return W_norm, q_norm, (ws_norm if ws_norm > 0.0 else 1.0), (qs_norm if qs_norm > 0.0 else 1.0)
-
-
-@jit
-def _lemke_friction_kernel(W, q, lo, hi, max_pivots, formulation):
-    """_lemke_friction_into with scratch and p, u of its own: (p, u, residual, status, pivots, norms)."""
-    floats, ints = solver_scratch(len(lo))
-    p, u = np.empty(2 * len(lo)), np.empty(2 * len(lo))
-    residual, status, pivots, q_norm, W_norm, scale = _lemke_friction_into(W, q, lo, hi, max_pivots, formulation,
-                                                                          floats, ints, p, u)
-    return p, u, residual, status, pivots, (q_norm, W_norm, scale)
 
 
 @jit_borrowing
@@ -744,8 +735,13 @@ def _run_friction_kernel(problem, formulation, max_pivots, jit):
     code = FORMULATIONS[formulation]
     if max_pivots is None:
         max_pivots = _default_max_pivots((3 if code == INTERVAL else 4) * problem.n_contacts)
-    kernel = _lemke_friction_kernel if jit else interpreted(_lemke_friction_kernel)
-    return kernel(problem.W, problem.q, problem.lo, problem.hi, int(max_pivots), code)
+    kernel = _lemke_friction_into if jit else interpreted(_lemke_friction_into)
+    n = problem.n_contacts  # (the loop's kernel, its scratch and p, u allocated here: _common.loop_array)
+    p, u = np.empty(2 * n), np.empty(2 * n)
+    residual, status, pivots, q_norm, W_norm, scale = kernel(
+        loop_array(problem.W), loop_array(problem.q), loop_array(problem.lo), loop_array(problem.hi), int(max_pivots),
+        code, np.empty(solver_floats(n)), np.empty(solver_ints(n), dtype=np.int64), p, u)
+    return p, u, residual, status, pivots, (q_norm, W_norm, scale)
 
 
 def _attempt(problem, formulation, max_pivots, tol, jit):

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import jit, jit_inline
+from ._common import loop_array, python_body
 from .delassus import coupled_components, group_matrix
 from .kernel_base import carve, carve_matrix, lu_factor, lu_solve
 from .problem import STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK
@@ -502,14 +503,18 @@ def _split_obeys_law(W, q, mode, sign, mu_s, p, u, velocity_tol, scale):
     return True
 
 
-@jit
 def admissible_split(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out):
     """The split of the step's impulses deepest inside every cone that keeps each contact in its
     mode (MODE_OPEN / MODE_STICK / MODE_SLIDE with slip sign `sign`), with normal
     complementarity (closed: u_N = 0, p_N ≥ 0; open: p = 0, u_N ≥ 0). Fills p_out and returns
-    True when one exists within the tolerances, False otherwise (p_out then undefined)."""
-    floats, ints = search_scratch(mode.shape[0])
-    return admissible_split_in(W, q, mu_s, mu_d, mode, sign, velocity_tol, scale, p_out, floats, ints)
+    True when one exists within the tolerances, False otherwise (p_out then undefined).
+    The search's compiled kernel with the loop's argument types, its scratch allocated here."""
+    na = mode.shape[0]
+    floats = np.empty(python_body(search_floats)(na))
+    ints = np.empty(python_body(search_ints)(na), dtype=np.int64)
+    return admissible_split_in(loop_array(W), loop_array(q), loop_array(mu_s), loop_array(mu_d),
+                               loop_array(mode, np.int64), loop_array(sign), float(velocity_tol), float(scale), p_out,
+                               floats, ints)
 
 
 @jit
@@ -707,10 +712,12 @@ def _without_gap_closing(q, closing, mode, q_held):
             q_held[2 * i] -= closing[i]
 
 
-@jit
 def prefer_sticking(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states):
-    """prefer_sticking_from without a previous split."""
-    return prefer_sticking_from(W, q, mu_s, mu_d, start_guess, velocity_tol, closing, p, u, states, np.zeros(0))
+    """prefer_sticking_from without a previous split: Python runs the loop's compiled kernel with the
+    loop's argument types (_common.loop_array; p, u, states are filled in place)."""
+    return prefer_sticking_from(loop_array(W), loop_array(q), loop_array(mu_s), loop_array(mu_d),
+                                loop_array(start_guess), float(velocity_tol), loop_array(closing), p, u, states,
+                                np.zeros(0))
 
 
 @jit

@@ -31,7 +31,7 @@ from .kernels import (KERNEL_NO_CONVERGENCE, KERNEL_SOLVED, carve, carve_matrix,
                       lemke_interval, pgs_block_into, solve_interval_into, solver_floats, solver_ints)
 from .gauss_seidel import PGS_FLOATS
 from .one_contact import one_contact_into
-from ._common import interpreted
+from ._common import interpreted, loop_array, python_body
 from .problem import (CONTACT_STATES, STATE_OPEN, STATE_SLIP_MINUS, STATE_SLIP_PLUS, STATE_STICK,  # noqa: F401
                       PlanarFrictionProblem, SolverError)
 from .registry import DEFAULT_SOLVER
@@ -156,12 +156,13 @@ def pgs_scratch_sizes(n_contacts):
     return floats, max(n_contacts, solver_ints(m))
 
 
-@jit
 def pgs_or_lemke(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback):
-    """pgs_or_lemke_into with scratch of its own (callers outside the step)."""
+    """pgs_or_lemke_into with scratch of its own, allocated here (callers outside the step): the
+    loop's compiled kernel with the loop's argument types (_common.loop_array)."""
     n_floats, n_ints = pgs_scratch_sizes(lo.shape[0])
-    return pgs_or_lemke_into(indptr, indices, blocks, q, lo, hi, p, u, rtol, max_iter, fallback, np.empty(n_floats),
-                             np.empty(n_ints, dtype=np.int64))
+    return pgs_or_lemke_into(loop_array(indptr, np.int64), loop_array(indices, np.int64), loop_array(blocks),
+                             loop_array(q), loop_array(lo), loop_array(hi), p, u, float(rtol), int(max_iter),
+                             bool(fallback), np.empty(n_floats), np.empty(n_ints, dtype=np.int64))
 
 
 @jit_borrowing
@@ -263,15 +264,17 @@ def _hold_search(W, indptr, indices, blocks, q, mu_s, mu_d, start_guess, resting
                                     u, states, MAX_DENSE_HOLD, p_start)
 
 
-@jit
 def two_coefficient_kernel(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting, rtol,
                            max_iter, p, u, states):
-    """two_coefficient_into with scratch of its own (Lemke's, or pgs's with its fallback)."""
+    """two_coefficient_into with scratch of its own (Lemke's, or pgs's with its fallback), allocated
+    here: Python runs the loop's compiled kernel with the loop's argument types (_common.loop_array;
+    guess, p, u, states are filled in place: the caller's float64 and int64 arrays)."""
     na = guess.shape[0]
     n_floats, n_ints = pgs_scratch_sizes(na) if indptr.shape[0] > 0 else (solver_floats(na), solver_ints(na))
-    floats, ints = np.empty(n_floats), np.empty(n_ints, dtype=np.int64)
-    return two_coefficient_into(solver_code, W, indptr, indices, blocks, q, mu_s, mu_d, guess, closing, resting,
-                                rtol, max_iter, p, u, states, floats, ints)
+    return two_coefficient_into(int(solver_code), loop_array(W), loop_array(indptr, np.int64),
+                                loop_array(indices, np.int64), loop_array(blocks), loop_array(q), loop_array(mu_s),
+                                loop_array(mu_d), guess, loop_array(closing), loop_array(resting), float(rtol),
+                                int(max_iter), p, u, states, np.empty(n_floats), np.empty(n_ints, dtype=np.int64))
 
 
 @jit_borrowing
@@ -403,15 +406,12 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
     any solver of solvers.solve (the same rule as two_coefficient_kernel: classify_solution and
     next_action, hold_at_rest). `closing` (per contact, default 0): the gap-closing part g/h of
     q_N, which a held body may leave open. Raises the solver's SolverError when a solve fails."""
-    W = np.ascontiguousarray(W, dtype=float)
-    q = np.ascontiguousarray(q, dtype=float)
-    mu_s = np.ascontiguousarray(mu_s, dtype=float)
-    mu_d = np.ascontiguousarray(mu_d, dtype=float)
+    W, q, mu_s, mu_d = loop_array(W), loop_array(q), loop_array(mu_s), loop_array(mu_d)
     guess = np.array(slip_guess, dtype=float)
     start_guess = guess.copy()
     na = guess.shape[0]
-    closing = np.zeros(na) if closing is None else np.ascontiguousarray(closing, dtype=float)
-    resting = np.ones(na) if resting is None else np.ascontiguousarray(resting, dtype=float)
+    closing = np.zeros(na) if closing is None else loop_array(closing)
+    resting = np.ones(na) if resting is None else loop_array(resting)
     classify, action_of = interpreted(classify_solution), interpreted(next_action)
     lo, hi, new_guess, states = np.empty(na), np.empty(na), np.empty(na), np.zeros(na, dtype=np.int64)
     tried = np.empty((max_solves + 1, na))
@@ -436,8 +436,9 @@ def solve_two_coefficient(W: np.ndarray, q: np.ndarray, mu_s: np.ndarray, mu_d: 
         last = action == NEXT_TRY_ZERO
     p, u = np.array(sol.p, dtype=float), np.array(sol.u, dtype=float)
     empty = np.zeros(0, dtype=np.int64)
-    if consistent and hold_at_rest(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess, resting,
-                                   max(velocity_tol, 10.0 * sol.residual), closing, p, u, states, np.zeros(0)):
+    if consistent and python_body(hold_at_rest)(W, empty, empty, np.zeros((0, 2, 2)), q, mu_s, mu_d, start_guess,
+                                                resting, max(velocity_tol, 10.0 * sol.residual), closing, p, u, states,
+                                                np.zeros(0)):
         interpreted(_guess_of_states)(states, guess)
     return StepContactResult(p, u, [STATE_NAMES[s] for s in states], guess.copy(), n_tried, iterations,
                              float(sol.residual), consistent)
