@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = 'b391f56743b29c5c971bbb194f458e06'
+SOURCES = '256b308d8ce86c84673a87b3576b8473'
 
 SHARES = (
     (
