@@ -50,7 +50,7 @@ import time
 
 import numpy as np
 
-from .._jit import ENABLED as HAVE_NUMBA, jit_inline
+from .._jit import ENABLED as HAVE_NUMBA
 from .._jit import jit, jit_borrowing, jit_inline
 from ..validation import InputError, quoted, require_integer, require_positive
 from ._common import RESIDUAL_FLOOR, interpreted, loop_array, require_finite_array
