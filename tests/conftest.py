@@ -4,9 +4,12 @@ A cold compiled run normally goes on interpreted while the engine compiles in th
 (`_jit`). Tests that check the compiled engine must run it, so the suite compiles in-process
 (`NONSMOOTH_ROD_COMPILE=wait`; a file lock lets one process compile each part while the others
 wait for it); tests/engine/test_compile_policy.py checks the default policy in its own process.
-On a cold cache the suite starts both compiled loops (whole-run and step-wise) in detached
-processes at once, so the tests that need no compiled engine run while they compile, and a test
-that needs one waits only for what is left.
+On a cold cache the suite starts the loop's compile job in a detached process, with the
+helper's share of the loop's callees in a second one (`_compile_split.start_share`: the job alone
+does not split, the workers being busy collecting when it starts), so the tests that need no
+compiled engine run while they compile, and a test that needs one waits only for what is left.
+The workers run niced while the loop is cold: its compile is the suite's longest path (fresh
+suite 192 → 182 s with the share, 167 s niced as well; docs/performance.md).
 
 Which tests run first: the files marked `no_compiled_loop` (they never run the compiled
 Moreau–Jean loop in-process — event-driven, solvers, validation, the fits — so they keep both
@@ -21,15 +24,23 @@ os.environ.setdefault("NONSMOOTH_ROD_COMPILE", "wait")
 def pytest_configure(config):
     if hasattr(config.option, "loadscopereorder"):  # pytest-xdist ≥ 3.8: keep the order set below
         config.option.loadscopereorder = False
-    if hasattr(config, "workerinput"):  # an xdist worker: the controller started the compiles
-        return
     from nonsmooth_rod import _jit
+
+    if hasattr(config, "workerinput"):  # an xdist worker: the controller started the compiles
+        if _jit.ENABLED and not _jit.engine_is_warm("moreau-jean") and hasattr(os, "nice"):
+            os.nice(10)  # the loop's compile is the suite's longest path: the workers take the cores it leaves
+        return
 
     if not _jit.ENABLED:
         return
     _jit.purge_stale_kernels()  # markers of edited sources do not count
     if not _jit.engine_is_warm("moreau-jean"):  # the one loop (runs with force callbacks use it too)
         _jit.start_compile_job("moreau-jean", [])
+        # and the helper's share of its callees at once (the job alone does not split: the
+        # workers are busy collecting when it starts, idle once the tests that need no loop ran)
+        from nonsmooth_rod import _compile_split
+
+        _compile_split.start_share(1)
 
 
 import pytest  # noqa: E402

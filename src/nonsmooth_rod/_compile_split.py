@@ -143,6 +143,20 @@ def _start_helper(index: int, module: str, log: Path | None):
             out.close()
 
 
+def start_share(index: int, module: str = SHARES_MODULE) -> bool:
+    """Start the helper process compiling share `index` into the cache and return at once (a
+    test suite starting the loop's compile job: see tests/conftest.py); False if it cannot be
+    started or there is no such share here."""
+    split = shares(module)
+    if usable_cores() < 2 or split is None or len(split) <= index or in_cache(split[index]):
+        return False
+    try:
+        _start_helper(index, module, None)
+    except OSError:
+        return False
+    return True
+
+
 def compile_callees(log: Path | None = None, module: str = SHARES_MODULE) -> bool:
     """Before the loop compiles cold: its callees compiled on two cores (the helper's share in a
     second process, the other here), returning once both are done. False when nothing was split

@@ -63,6 +63,26 @@ def test_the_helper_compiles_its_share_into_the_cache_and_the_caller_finds_both(
     assert not _compile_split.compile_callees(log, module) and not log.exists()  # cached: no helper again
 
 
+def test_a_share_started_in_the_background_lands_in_the_cache_once(tmp_path, monkeypatch):
+    """start_share (the suite's conftest: the helper's share beside the loop's job) returns at
+    once; its process compiles the share into the cache, and a cached share is not started again."""
+    name = f"fake_pair_{tmp_path.name.replace('-', '_')}"
+    module = _fake_shares(tmp_path, monkeypatch, name, f"((({name!r}, 'double', '(float64[::1],)'),),"
+                                                       f" (({name!r}, 'square', '(float64[::1],)'),))")
+    monkeypatch.setattr(_compile_split, "usable_cores", lambda: 2)
+    assert not _compile_split.start_share(2, module)  # no such share
+    split = _compile_split.shares(module)
+    assert not _compile_split.in_cache(split[1])
+    assert _compile_split.start_share(1, module)
+    deadline = time.monotonic() + 120
+    while not _compile_split.in_cache(split[1]) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert _compile_split.in_cache(split[1]) and not _compile_split.in_cache(split[0])
+    assert not _compile_split.start_share(1, module)  # cached: nothing to start
+    monkeypatch.setattr(_compile_split, "usable_cores", lambda: 1)
+    assert not _compile_split.start_share(0, module)  # one core: the loop's job compiles it
+
+
 def test_shares_that_cannot_be_rebuilt_or_one_core_split_nothing(tmp_path, monkeypatch):
     name = f"fake_pair_{tmp_path.name.replace('-', '_')}"
     module = _fake_shares(tmp_path, monkeypatch, name, f"((({name!r}, 'double', '(NoSuchType[::1],)'),), ())")
