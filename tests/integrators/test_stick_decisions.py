@@ -5,6 +5,8 @@ step's own (the trajectory of the step's law alone), and scenes the hybrid metho
 are left to the step's law."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -167,3 +169,39 @@ def test_contacts_declared_in_another_order_get_the_same_decisions():
     assert [c.name for c in scene.contacts] == ["B", "A"] and run.stats["stick_predictions"] == 1
     assert [p.mode for p in run.phases["A"]] == [p.mode for p in reference.phases["A"]] == ["stick", "slip+"]
     assert abs(run.phases["A"][0].t_end - reference.phases["A"][0].t_end) < 1e-6
+
+
+_REFUSED: list = []
+
+
+def test_a_run_whose_steps_go_interpreted_predicts_interpreted_with_the_same_decisions(monkeypatch):
+    """A cold cache runs the steps interpreted while the engine compiles in the background; the
+    run's predictions then run the hybrid's plain-Python twins (compiling them would make the
+    user wait ~5 s: issue 25's first run), and decide as the compiled ones: the same source."""
+    from nonsmooth_rod import _jit
+    from nonsmooth_rod.integrators import hybrid
+    from nonsmooth_rod.model import dynamics
+
+    if not _jit.ENABLED:
+        pytest.skip("numba not installed: every kernel is interpreted")
+    problem = RodProblem.paper(2)
+    q0, v0 = problem.initial_state()
+    compiled = nr.simulate(problem.scene(), q0, v0, 0.5, h=1e-3, solver="lemke")
+
+    class CompiledRefused:  # a kernel called compiled fails; its twin (py_func) runs
+        def __init__(self, kernel):
+            self.py_func = kernel.py_func
+
+        def __call__(self, *args):
+            raise AssertionError(f"{self.py_func.__name__} called compiled")
+
+    for module, name in ((hybrid, "screened_steps_into"), (hybrid, "hermite_into"),
+                         (dynamics, "mode_rates_into"), (dynamics, "runge_kutta_into")):
+        _REFUSED.append(CompiledRefused(getattr(module, name)))  # (kept: twins are cached by id)
+        monkeypatch.setattr(module, name, _REFUSED[-1])
+    hybrid._mode_system_twins.cache_clear()
+    monkeypatch.setattr(hybrid, "_mode_system_twins", functools.cache(hybrid._mode_system_twins.__wrapped__))
+    plain = nr.simulate(problem.scene(), q0, v0, 0.5, h=1e-3, solver="lemke", fast=False)
+    assert plain.stats["stick_predictions"] == compiled.stats["stick_predictions"] == 2
+    assert [(e.kind, e.contact) for e in plain.events] == [(e.kind, e.contact) for e in compiled.events]
+    assert np.allclose([e.t for e in plain.events], [e.t for e in compiled.events], rtol=0, atol=1e-12)

@@ -27,6 +27,7 @@ where it declines (a statically indeterminate A).
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -34,6 +35,7 @@ import numpy as np
 
 from ..model.dynamics import ModeDynamics, ModeSystem, hermite_into, mode_dynamics
 from ..solvers import available_solvers
+from ..solvers._common import interpreted
 from ..validation import Choice, Integer, Number, Text, check_options, option
 from .declaration import NO_DRIVEN, NO_JOINTS, Declaration
 from .sampling import thinned_count
@@ -136,14 +138,22 @@ class _Stage:
         return self.mode.dynamics(self._solved)
 
 
-def _hermite(a: _Stage, b: _Stage):
+@functools.cache
+def _mode_system_twins():
+    """ModeSystem's compiled mode solve and step as plain-Python twins (made once)."""
+    from ..model import dynamics
+
+    return interpreted(dynamics.mode_rates_into), interpreted(dynamics.runge_kutta_into)
+
+
+def _hermite(a: _Stage, b: _Stage, interpolate_into=hermite_into):
     """The step's cubic Hermite interpolant of (q, v) from both ends' (q, v) and (v, a)."""
     h = b.t - a.t
 
     def dense(t: float) -> np.ndarray:
         s = (t - a.t) / h
         out = np.empty_like(a.y)
-        hermite_into(((1 + 2 * s) * (1 - s) ** 2, s * s * (3 - 2 * s), s * (1 - s) ** 2, s * s * (s - 1)), h, a.y, b.y,
+        interpolate_into(((1 + 2 * s) * (1 - s) ** 2, s * s * (3 - 2 * s), s * (1 - s) ** 2, s * s * (s - 1)), h, a.y, b.y,
                      a.f, b.f, out)
         return out
     return dense
@@ -251,6 +261,10 @@ class Hybrid(EventDriven):
 
     def __init__(self, options: HybridOptions | None = None):
         self.options = options or HybridOptions()
+        # False: the mode solves, steps, screen and interpolation run as their plain-Python twins
+        # (a fixed-step run's prediction while its engine runs interpreted and compiles in the
+        # background: stick_decisions; a cold cache then compiles nothing here)
+        self.compiled = True
         self._systems = {}
 
     def run(self, scene, q0, v0, t_end, **clock):
@@ -262,7 +276,13 @@ class Hybrid(EventDriven):
         if key not in self._systems:  # the scene's packed contacts shared by its systems in this run
             like = next(iter(self._systems.values()), None)
             self._systems[key] = ModeSystem(scene, modes, watched, like)
-        return self._systems[key]
+        system = self._systems[key]
+        system.twins = None if self.compiled else _mode_system_twins()
+        return system
+
+    def _kernel(self, kernel):
+        """A compiled kernel, or its plain-Python twin while `compiled` is False."""
+        return kernel if self.compiled else interpreted(kernel)
 
     def _dynamics(self, scene, t, q, v, modes, kin=None):
         """The reference's mode decisions, rest and samples by the compiled mode solve, or
@@ -305,7 +325,7 @@ class Hybrid(EventDriven):
             cap *= GROWTH
             middle, end = self._step(mode, start, step, counts)
             counts.steps += 1
-            dense = _hermite(start, end)
+            dense = _hermite(start, end, self._kernel(hermite_into))
             ts = (start.t, middle.t, end.t)
             hit = watch.first_event_sampled(dense, ts, np.array([s_start, watch.values(middle),
                                                                  s_end := watch.values(end)]))
@@ -340,7 +360,8 @@ class Hybrid(EventDriven):
                 break
             states, outs = np.empty((len(steps), len(c) + 1, start.y.shape[0])), np.empty((len(steps), len(c) + 1,
                                                                                             system.out.shape[0]))
-            m = screened_steps_into(system.table, system.ints, system.watched, system.offsets, system.minv, system.free,
+            screen = self._kernel(screened_steps_into)
+            m = screen(system.table, system.ints, system.watched, system.offsets, system.minv, system.free,
                                     start.y, np.array(steps), np.array(tb), a_array, b_array, mid, float(c[mid]),
                                     float(watch.t0), watch.sign, watch.noise, watch.band_exit, s_start, DIP_FRACTION,
                                     states, outs)
@@ -356,7 +377,8 @@ class Hybrid(EventDriven):
                 end = _Stage(mode, tb[m + 1], states[m, -1], outs[m, -1])
                 s_end = watch.sign * end.values
                 watch.evaluations += 2
-                hit = watch.first_event_sampled(_hermite(start, end), (tb[m], tb[m] + c[mid] * steps[m], tb[m + 1]),
+                dense = _hermite(start, end, self._kernel(hermite_into))
+                hit = watch.first_event_sampled(dense, (tb[m], tb[m] + c[mid] * steps[m], tb[m + 1]),
                                                 np.array([s_start, watch.sign * outs[m, mid, system.values], s_end]))
                 if hit is not None or end.t >= t_end:
                     return hit

@@ -356,7 +356,7 @@ class MoreauJean:
         engine = Engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
         self._solver_error = None
         wall = time.process_time()
-        decisions = stick_decisions(scene, model, grid, plan)
+        decisions = stick_decisions(scene, model, grid, plan, engine)
         with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
             ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop),
                                    decisions)

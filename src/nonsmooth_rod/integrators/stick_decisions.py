@@ -83,7 +83,7 @@ class _ModeRun(NamedTuple):  # (a tuple: made at every call's first review, a fr
     codes: tuple  # each contact's state code (Python ints: read one at a time)
 
 
-def stick_decisions(scene, model, grid, plan=None):
+def stick_decisions(scene, model, grid, plan=None, engine=None):
     """The run's StickDecisions, or None where the hybrid method does not run the scene's contacts
     (its other refusals, joints and driven things, are checked at the first prediction, and kept
     in the scene's plan for its later runs: integrators/scene_plans.py)."""
@@ -91,7 +91,9 @@ def stick_decisions(scene, model, grid, plan=None):
         return None
     if plan is not None and plan.predicted is False:
         return None
-    return StickDecisions(scene, model.contacts, grid, plan)
+    decisions = StickDecisions(scene, model.contacts, grid, plan)
+    decisions.engine = engine  # (its predictions run compiled when the run's steps do: _prediction)
+    return decisions
 
 
 class StickDecisions:
@@ -111,6 +113,7 @@ class StickDecisions:
         # step's ratios (held, or overshooting)
         self.switches: dict[tuple[int, int], float] = {}
         self.predictions = 0
+        self.engine = None  # the run's Engine (moreau_jean): whether its steps run compiled now
         self._ahead: dict = {}  # a mode run's first step → its prediction (each contact's break-away reads it)
 
     def steps(self, k: int, n: int) -> int:
@@ -221,6 +224,9 @@ class StickDecisions:
         if start.k not in self._ahead:
             modes = [STATE_NAMES[int(c)] for c in start.codes]
             hybrid = self._predictor()
+            # steps run interpreted (a cold cache: the engine compiles in the background, or
+            # fast=False): so does the prediction, which then compiles nothing (the same source)
+            hybrid.compiled = self.engine is None or self.engine.compiled
             self._ahead[start.k] = NOT_PREDICTED
             try:  # (a stick singular at every state, the pushed block's: declined before the projection)
                 v = self.smooth.consistent_velocity(self.scene, start.q, start.v, modes) \

@@ -164,6 +164,11 @@ class ModeSystem:
     `watched`: (what, contact, offset) triples, `what` a key of WATCH_CODES; each value is the
     quantity minus the offset."""
 
+    # None: the compiled mode solve and step; or their plain-Python twins (mode_rates_into's,
+    # runge_kutta_into's: solvers._common.interpreted), set by a caller whose run goes on
+    # interpreted while the engine compiles (a prediction then compiles nothing: hybrid.py)
+    twins = None
+
     def __init__(self, scene: Scene, modes, watched=(), like: ModeSystem | None = None):
         n, nc = scene.n_dof, len(scene.contacts)
         self.scene, self.n_dof = scene, n
@@ -203,7 +208,8 @@ class ModeSystem:
         if not self.constant:
             n = self.n_dof
             free = self.minv * self.scene.force(t, y[:n], y[n:])
-        if not mode_rates_into(self.table, self.ints, self.watched, self.offsets, self.minv, free, y, self.out):
+        rates_into = mode_rates_into if self.twins is None else self.twins[0]
+        if not rates_into(self.table, self.ints, self.watched, self.offsets, self.minv, free, y, self.out):
             return None
         return self.out.copy()
 
@@ -217,8 +223,9 @@ class ModeSystem:
             return None
         s = b.shape[0]
         states, outs = np.empty((s + 1, y.shape[0])), np.empty((s + 1, self.out.shape[0]))
-        if not runge_kutta_into(self.table, self.ints, self.watched, self.offsets, self.minv, self.free, y, h, a, b,
-                                states, outs):
+        step_into = runge_kutta_into if self.twins is None else self.twins[1]
+        if not step_into(self.table, self.ints, self.watched, self.offsets, self.minv, self.free, y, h, a, b,
+                         states, outs):
             return None
         return states, outs
 
