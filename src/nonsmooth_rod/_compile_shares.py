@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = '94ab9b4a85eb6bc870ae7cf5d872fccc'
+SOURCES = '7abbd7c46dd5bb4bb29be5ca2110c65d'
 
 SHARES = (
     (
