@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = '7abbd7c46dd5bb4bb29be5ca2110c65d'
+SOURCES = '2e52d09881af884617370346729921f5'
 
 SHARES = (
     (

@@ -153,8 +153,8 @@ def _hermite(a: _Stage, b: _Stage, interpolate_into=hermite_into):
     def dense(t: float) -> np.ndarray:
         s = (t - a.t) / h
         out = np.empty_like(a.y)
-        interpolate_into(((1 + 2 * s) * (1 - s) ** 2, s * s * (3 - 2 * s), s * (1 - s) ** 2, s * s * (s - 1)), h, a.y, b.y,
-                     a.f, b.f, out)
+        interpolate_into(((1 + 2 * s) * (1 - s) ** 2, s * s * (3 - 2 * s), s * (1 - s) ** 2, s * s * (s - 1)), h,
+                         a.y, b.y, a.f, b.f, out)
         return out
     return dense
 
@@ -361,10 +361,9 @@ class Hybrid(EventDriven):
             states, outs = np.empty((len(steps), len(c) + 1, start.y.shape[0])), np.empty((len(steps), len(c) + 1,
                                                                                             system.out.shape[0]))
             screen = self._kernel(screened_steps_into)
-            m = screen(system.table, system.ints, system.watched, system.offsets, system.minv, system.free,
-                                    start.y, np.array(steps), np.array(tb), a_array, b_array, mid, float(c[mid]),
-                                    float(watch.t0), watch.sign, watch.noise, watch.band_exit, s_start, DIP_FRACTION,
-                                    states, outs)
+            m = screen(system.table, system.ints, system.watched, system.offsets, system.minv, system.free, start.y,
+                       np.array(steps), np.array(tb), a_array, b_array, mid, float(c[mid]), float(watch.t0), watch.sign,
+                       watch.noise, watch.band_exit, s_start, DIP_FRACTION, states, outs)
             done = len(steps) if m == len(steps) else m if m >= 0 else -1 - m  # steps passed
             if done:
                 start = _Stage(mode, tb[done], states[done - 1, -1], outs[done - 1, -1])

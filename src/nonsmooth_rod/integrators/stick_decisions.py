@@ -91,17 +91,16 @@ def stick_decisions(scene, model, grid, plan=None, engine=None):
         return None
     if plan is not None and plan.predicted is False:
         return None
-    decisions = StickDecisions(scene, model.contacts, grid, plan)
-    decisions.engine = engine  # (its predictions run compiled when the run's steps do: _prediction)
-    return decisions
+    return StickDecisions(scene, model.contacts, grid, plan, engine)
 
 
 class StickDecisions:
     """The holds and releases a fixed-step run's chunks of steps run in, and the review of each
     chunk's break-aways that plans them."""
 
-    def __init__(self, scene, table, grid, plan=None):
+    def __init__(self, scene, table, grid, plan=None, engine=None):
         self.scene, self.table, self.grid, self.plan = scene, table, grid, plan
+        self.engine = engine  # the run's Engine (moreau_jean): its predictions run compiled when its steps do
         self.smooth = None  # adaptive_breakaway: at the first prediction
         self.handled = True  # until the first prediction finds a refusal of the hybrid method
         self.run_start: _ModeRun | None = None
@@ -113,7 +112,6 @@ class StickDecisions:
         # step's ratios (held, or overshooting)
         self.switches: dict[tuple[int, int], float] = {}
         self.predictions = 0
-        self.engine = None  # the run's Engine (moreau_jean): whether its steps run compiled now
         self._ahead: dict = {}  # a mode run's first step → its prediction (each contact's break-away reads it)
 
     def steps(self, k: int, n: int) -> int:
