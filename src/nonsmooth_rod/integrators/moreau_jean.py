@@ -40,7 +40,7 @@ from . import accumulation
 from . import moreau_jean_loop as loop
 from .declaration import Declaration, Refusal, first_driven, first_joint
 from .direct_entry import DirectEntry
-from .carved import carve_zeros
+from .carved import carve_zeros, owners
 from .joint_step import work_size
 from .sampling import first_hold, stop_event, stop_holds, stop_message, thinned_count
 from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
@@ -208,6 +208,13 @@ def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int, slip
     # its result then holds it); a larger one has them taken in the run, as its result's end state
     window.defer_rows = lent is not None or sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES
     return window
+
+
+def _snapshot(work, window: Window):
+    """(the work arrays' buffers and their copies, the window's counters' copy) at a chunk's start,
+    for the chunk to be run again from it (a Work is carved from a buffer per dtype: two copies)."""
+    buffers = owners(work)
+    return (buffers, [b.copy() for b in buffers]), window.out.counters.copy()
 
 
 def _same_float(a: float, b: float) -> bool:
@@ -433,13 +440,16 @@ class MoreauJean:
             return loop.RUN_STOPPED_BY_CONDITION, k
         while k < grid.last:
             if window.room() == 0:
+                if decisions is not None:
+                    decisions.keep_start()  # (its rows move)
                 window.slide()
             last = bool(grid.h_last) and k == grid.last - 1
             n = engine.steps(1 if last else min(window.room(), grid.first + grid.n_full - k))
             n = n if decisions is None else decisions.steps(k, n)
             step_params = self._shortened(params, grid, window, k) if last else params
             params[loop.P_K0] = window.k_base
-            snapshot = ([w.copy() for w in work], window.out.counters.copy()) if stops or decisions else None
+            taken_back = stops or (decisions is not None and decisions.may_take_back(window, k, n))
+            snapshot = _snapshot(work, window) if taken_back else None
             held = contextlib.nullcontext() if decisions is None else decisions.holding(k)
             started = time.perf_counter()
             with held:
@@ -465,9 +475,8 @@ class MoreauJean:
     def _replay(self, engine, scene, window, snapshot, k, k_to, arrays, held) -> int:
         """The chunk's steps from k run again to k_to, from the work memory and counters of
         `snapshot` (taken at k), in the context `held` it ran in; returns k_to."""
-        work = arrays[3]
-        for w, saved in zip(work, snapshot[0]):
-            w[...] = saved
+        for buffer, saved in zip(*snapshot[0]):
+            buffer[...] = saved
         window.out.counters[:] = snapshot[1]
         window.r = k - window.k_base
         if k_to > k:

@@ -103,7 +103,8 @@ class StickDecisions:
         self.engine = engine  # the run's Engine (moreau_jean): its predictions run compiled when its steps do
         self.smooth = None  # adaptive_breakaway: at the first prediction
         self.handled = True  # until the first prediction finds a refusal of the hybrid method
-        self.run_start: _ModeRun | None = None
+        self._run_start: _ModeRun | None = None
+        self._start_row = None  # (window, row) of the run of modes' first step, read on first need (run_start)
         self.held: dict[int, tuple[int, int]] = {}  # contact → (first step held, first step not held)
         self.released: dict[int, tuple[int, int]] = {}  # contact → (first step released, first not)
         self.acted: set[int] = set()  # the first steps of the mode runs acted on
@@ -135,10 +136,10 @@ class StickDecisions:
         that step on are to be run again, under the plan this review made), or None: all kept."""
         r0, r1 = k - window.k_base, k_done - window.k_base
         lo = max(r0 - 1, 0)
-        if self.run_start is None:
-            self._start(window, lo, window.full(5, lo))
-        if not self.handled:
-            return None
+        if self._run_start is None and self._start_row is None:
+            self._start(window, lo)
+        if not self.handled or r1 - lo < 2:
+            return None  # (a call's one-step chunk: no two rows to compare)
         columns = window.out.states[lo:r1]  # the contacts' columns (contacts never near: no column, open)
         differ = np.flatnonzero(columns[1:] != columns[:-1])  # (flat: an any(axis=1) costs 5 µs a chunk)
         if not differ.size:
@@ -152,19 +153,39 @@ class StickDecisions:
                      if was == STATE_STICK and p > 0.0 and now in SLIDING]  # loaded, sticking, then sliding
             if broke:
                 if start is not None:  # the mode run the break-away ends started at the change before it
-                    self._start(window, start, window.full(5, start))
+                    self._start(window, start)
                 for i in sorted(window.owners()[broke].tolist()):  # (each contact's column: Window.columns)
                     back = self._confirm(i, window.k_base + r, k)
                     if back is not None:
                         return back
             start = r
-        self._start(window, start, window.full(5, start))
+        self._start(window, start)
         return None
 
-    def _start(self, window, r: int, codes) -> None:
-        k = window.k_base + r
-        self.run_start = _ModeRun(k, float(self.grid.time(k)), window.out.q[r].copy(), window.out.v[r].copy(),
-                                  tuple(codes.tolist()))
+    def may_take_back(self, window, k: int, n: int) -> bool:
+        """Whether the review of a chunk of n steps from step k can take steps back (it compares
+        the modes of consecutive rows from the one before the chunk's: a run's first chunk of one
+        step has no two)."""
+        return self.handled and (n > 1 or k > window.k_base)
+
+    def _start(self, window, r: int) -> None:
+        """Row r of the window starts a run of modes: read from the window on first need, or
+        before its rows move or are run again (`keep_start`; a review that reads it does)."""
+        self._start_row, self._run_start = (window, r), None
+
+    def keep_start(self) -> None:
+        """Copy the run of modes' first step out of the window: its rows are about to move."""
+        if self._start_row is not None:
+            window, r = self._start_row
+            k = window.k_base + r
+            self._run_start = _ModeRun(k, float(self.grid.time(k)), window.out.q[r].copy(), window.out.v[r].copy(),
+                                       tuple(window.full(5, r).tolist()))
+            self._start_row = None
+
+    @property
+    def run_start(self) -> _ModeRun | None:
+        self.keep_start()
+        return self._run_start
 
     def _confirm(self, i: int, k_break: int, k_chunk: int) -> int | None:
         """The step to go back to for contact i's break-away, the first step it slides in being
