@@ -362,39 +362,50 @@ __all__ = ["jit", "ENABLED", "one_blas_thread", "compiling", "compile_in_backgro
 # one thread (threadpoolctl, in the `fast` extra; without it this does nothing).
 _blas = None
 _blas_depth = 0  # nested uses (a sweep's batch around its runs) limit and restore once
+_blas_restore: list = []  # (set_threads, threads) the outermost use restores on leaving
 
 
-class one_blas_thread:
-    """Context manager: BLAS/LAPACK (numpy's and scipy's OpenBLAS, which numba's kernels call) on
-    one thread inside, the previous limits restored after. The libraries and their thread-count
-    functions are looked up once per process (threadpoolctl); entering then costs two ctypes calls
-    per library and leaving one (~1 µs in all: threadpoolctl's own methods cost ~13 µs, 4
-    yardsticks of a short run's fixed cost), and nested inside another use it is free — so a
-    sweep wraps its whole batch once, not each short run."""
+class _OneBlasThread:
+    """one_blas_thread's context (one, shared: it holds no state of its own)."""
+
+    __slots__ = ()
 
     def __enter__(self):
-        global _blas, _blas_depth
-        self._restore = ()
+        global _blas, _blas_depth, _blas_restore
         _blas_depth += 1
-        if _blas_depth > 1:
-            return self
-        if _blas is None:
-            _blas = _blas_libraries()
-        restore = []
-        for get_threads, set_threads in _blas:
-            threads = get_threads()
-            if threads != 1:
-                set_threads(1)
-                restore.append((set_threads, threads))
-        self._restore = restore
+        if _blas_depth == 1:
+            if _blas is None:
+                _blas = _blas_libraries()
+            restore = []
+            for get_threads, set_threads in _blas:
+                threads = get_threads()
+                if threads != 1:
+                    set_threads(1)
+                    restore.append((set_threads, threads))
+            _blas_restore = restore
         return self
 
     def __exit__(self, exc_type, exc, tb):
         global _blas_depth
         _blas_depth -= 1
-        for set_threads, threads in self._restore:
-            set_threads(threads)
+        if _blas_depth == 0:
+            for set_threads, threads in _blas_restore:
+                set_threads(threads)
         return False
+
+
+_ONE_BLAS_THREAD = _OneBlasThread()
+
+
+def one_blas_thread() -> _OneBlasThread:
+    """Context manager: BLAS/LAPACK (numpy's and scipy's OpenBLAS, which numba's kernels call) on
+    one thread inside, the previous limits restored after. The libraries and their thread-count
+    functions are looked up once per process (threadpoolctl); entering then costs two ctypes calls
+    per library and leaving one (~1 µs in all: threadpoolctl's own methods cost ~13 µs, 4
+    yardsticks of a short run's fixed cost), and nested inside another use it is free — so a
+    sweep wraps its whole batch once, not each short run. (One shared context, no object a use:
+    a run's fixed cost counts every attribute.)"""
+    return _ONE_BLAS_THREAD
 
 
 def _blas_libraries() -> list:

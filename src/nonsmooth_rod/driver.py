@@ -97,7 +97,7 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     result = integrator_cls(opts).run(scene, q0, v0, t_end, t0=t0, resume=resume, save_every=save_every,
                                       stop=callables)
     result.method = method
-    result.setup = RunSetup(scene, method, dict(options), stop, save_every, q0, v0, t0, t_end)
+    result.setup = RunSetup(scene, method, options, stop, save_every, q0, v0, t0, t_end)  # (options: this call's own dict)
     return result
 
 

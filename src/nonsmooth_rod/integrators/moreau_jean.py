@@ -450,11 +450,12 @@ class MoreauJean:
             params[loop.P_K0] = window.k_base
             taken_back = stops or (decisions is not None and decisions.may_take_back(window, k, n))
             snapshot = _snapshot(work, window) if taken_back else None
-            held = contextlib.nullcontext() if decisions is None else decisions.holding(k)
-            started = time.perf_counter()
+            held = _NOTHING if decisions is None else decisions.holding(k)
+            started = time.perf_counter() if engine.probing else None
             with held:
                 status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
-            engine.measured(k_done - k, time.perf_counter() - started, grid.last - k_done, status)
+            if started is not None:
+                engine.measured(k_done - k, time.perf_counter() - started, grid.last - k_done, status)
             k_back = decisions.review(window, k, k_done) if decisions and status in REVIEWED else None
             if k_back is not None:  # its steps from k_back on are run again, as the review planned
                 k_done = self._replay(engine, scene, window, snapshot, k, k_back, (step_params, iparams, model, work), held)

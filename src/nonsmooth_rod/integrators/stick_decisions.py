@@ -87,9 +87,11 @@ def stick_decisions(scene, model, grid, plan=None, engine=None):
     """The run's StickDecisions, or None where the hybrid method does not run the scene's contacts
     (its other refusals, joints and driven things, are checked at the first prediction, and kept
     in the scene's plan for its later runs: integrators/scene_plans.py)."""
-    if not scene.contacts or any(type(c).__name__ not in PREDICTED_CONTACTS for c in scene.contacts):
+    predicted = None if plan is None else plan.predicted  # (True: its contacts were checked before)
+    if predicted is False:
         return None
-    if plan is not None and plan.predicted is False:
+    if predicted is None and (not scene.contacts or any(type(c).__name__ not in PREDICTED_CONTACTS
+                                                        for c in scene.contacts)):
         return None
     return StickDecisions(scene, model.contacts, grid, plan, engine)
 
@@ -97,6 +99,9 @@ def stick_decisions(scene, model, grid, plan=None, engine=None):
 class StickDecisions:
     """The holds and releases a fixed-step run's chunks of steps run in, and the review of each
     chunk's break-aways that plans them."""
+
+    __slots__ = ("scene", "table", "grid", "plan", "engine", "smooth", "handled", "_run_start", "_start_row",
+                 "held", "released", "acted", "switches", "predictions", "_ahead")
 
     def __init__(self, scene, table, grid, plan=None, engine=None):
         self.scene, self.table, self.grid, self.plan = scene, table, grid, plan
