@@ -329,3 +329,31 @@ def test_the_records_of_a_long_found_run_take_memory_by_the_contacts_that_come_n
     kept = 201 * len(scene.contacts) * (8 + 8 + 1 + 8)  # the result's samples: N, T, codes, modes
     assert peak <= records + kept + (3 << 20), (peak, records)  # (+ the windows' temporaries)
     assert peak < rows * 8 * 4 * len(scene.contacts) / 4  # (every listed contact's records: 218 MB)
+
+
+def test_samples_hold_each_steps_state_and_its_records_over_its_own_size_compiled_or_not():
+    """A kept sample at step k is the state there and the step that led to it divided by that
+    step's size: a = Δv/h (h_last for the shortened last step), t = k h (t_end at the last); the
+    first sample, which no step leads to, has a = NaN and no forces. The compiled kernel that takes
+    them (moreau_jean_records.samples_into) and its interpreted twin give the same bits."""
+    toy = toys.BlockOnIncline()
+    scene, (q0, v0) = toy.scene(), toy.initial_state()
+    h, t_end = 1e-3, 0.0415  # 41 whole steps, then one of 0.5 ms
+    compiled = nr.simulate(scene, q0, v0, t_end, h=h, solver="lemke")
+    plain = nr.simulate(scene, q0, v0, t_end, h=h, solver="lemke", fast=False)
+    assert compiled.stats["compiled"] or not nr._jit.ENABLED
+    t, v, a = compiled.t, compiled.v, compiled.trajectory.a
+    k = np.arange(t.size)
+    assert t.size == 43 and t[-1] == t_end
+    np.testing.assert_array_equal(t[:-1], k[:-1] * h)
+    h_last = t_end - 41 * h
+    steps = np.r_[np.full(41, h), h_last]
+    np.testing.assert_array_equal(a[1:], (v[1:] - v[:-1]) / steps[:, None])
+    assert np.isnan(a[0]).all() and not compiled.normal_force[0].any() and not compiled.tangential_force[0].any()
+    # flat on the incline, its corners' normal forces carry the weight's normal part, m g cos α
+    np.testing.assert_allclose(compiled.normal_force[1:].sum(axis=1), toy.mass * toy.g * math.cos(toy.angle),
+                               rtol=1e-9)
+    for name in ("t", "q", "v", "normal_force", "tangential_force"):
+        np.testing.assert_array_equal(getattr(plain, name), getattr(compiled, name), err_msg=name)
+    np.testing.assert_array_equal(plain.trajectory.a, a)
+    assert plain.modes.tolist() == compiled.modes.tolist()

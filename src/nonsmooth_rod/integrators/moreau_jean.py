@@ -47,7 +47,7 @@ from .moreau_jean_loop import ACTIVATION_ROUNDOFF  # noqa: F401  (re-exported)
 from .scene_plans import scene_plan
 from .stick_decisions import stick_decisions
 from .moreau_jean_records import (HISTORY, MAX_CHUNK, WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN, Collector, Grid,
-                                 ResumeState, Window, kept_steps)
+                                  ResumeState, Window, compile_samples, kept_steps)
 
 # A window row with the temporaries of collecting from it, in samples (bench_memory.py, ball,
 # 65 536-step windows, save_every = 0.1 s: 8.1 MB measured for 1e6 and 1e7 steps).
@@ -308,7 +308,14 @@ class Engine:
         if not self.compiled or _jit.engine_is_warm(self.part):  # (a set lookup once known warm)
             return _NOTHING
         # the loop's callees compiled on two cores before it (_compile_split)
-        return _jit.compiling(self.part, self.what, prepare=compile_callees if self.part == LOOP_PART else None)
+        return _jit.compiling(self.part, self.what, prepare=_prepare_loop if self.part == LOOP_PART else None)
+
+
+def _prepare_loop(log) -> None:
+    """Before the loop compiles: its callees on two cores, and the samples' kernel (what a run
+    calls compiled besides the loop)."""
+    compile_callees(log)
+    compile_samples()
 
 
 # The endings of a chunk of steps whose break-aways are reviewed (stick_decisions): every step
@@ -436,7 +443,7 @@ class MoreauJean:
         break-aways reviewed by them; returns (run status, global step the run ended at)."""
         k = grid.first
         if stops and stop_holds(stops, grid.time(k), window.out.q[window.r], window.out.v[window.r]):
-            collector.take(window, k, k, final=True)
+            collector.take(window, k, k, final=True, compiled=engine.compiled)
             return loop.RUN_STOPPED_BY_CONDITION, k
         while k < grid.last:
             if window.room() == 0:
@@ -464,10 +471,10 @@ class MoreauJean:
             if k_hold is not None:
                 if k_hold < k_done:  # replay to the step where it holds: the end state is that step's
                     self._replay(engine, scene, window, snapshot, k, k_hold, (step_params, iparams, model, work), held)
-                collector.take(window, k, k_hold, final=True)
+                collector.take(window, k, k_hold, final=True, compiled=engine.compiled)
                 return loop.RUN_STOPPED_BY_CONDITION, k_hold
             final = status != loop.RUN_OK or k_done == grid.last
-            collector.take(window, k, k_done, final=final)
+            collector.take(window, k, k_done, final=final, compiled=engine.compiled)
             k = k_done
             if status != loop.RUN_OK:
                 return status, k

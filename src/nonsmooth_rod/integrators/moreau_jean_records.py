@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._jit import jit_borrowing
+from ..solvers._common import interpreted
 from . import moreau_jean_loop as loop
 from .sampling import save_slots
 
@@ -118,16 +120,6 @@ class Grid:
         # dozen times, and a cached property's first read (its lock) costs more than computing both
         self.n_steps: int = self.n_full + (1 if self.h_last else 0)
         self.last: int = self.first + self.n_steps
-
-    def times_into(self, lo: int, t: np.ndarray) -> None:
-        """`time` of the consecutive steps lo, lo + 1, … written into `t` (its values bit for bit:
-        the same product and sum a step; the run's last step t_end exactly)."""
-        n = t.shape[0]
-        if n:
-            np.multiply(np.arange(lo, lo + n, dtype=float), self.h, out=t)
-            t += self.origin
-            if lo + n - 1 == self.last:
-                t[-1] = self.t_end
 
     def time(self, k: np.ndarray | int):
         """Times of global step indices (the last one: t_end exactly)."""
@@ -294,6 +286,58 @@ def count_kept(grid: Grid, save_every: float | None) -> int:
     return total
 
 
+@jit_borrowing
+def samples_into(ks, k_base, m0, origin, h, last, t_end, h_last, first, first_h, resumed, q, v, p_normal, p_tangent,
+                 states, joint_impulse, contacts, columns, t, q_out, v_out, a, N, T, codes, joint_force):
+    """The samples of global steps ks (window rows ks − k_base) into rows m0 … of the collector's
+    t, q, v, a, N, T, codes, joint_force: the state at each; the records of the step that led to
+    it over its size (a = Δv/h, N = p_N/h, T = p_T/h, the joints' impulses/h; the run's first
+    state, which no step leads to: a NaN, N = T = 0, the modes of its first step). The step ending
+    at k is h, h_last for the grid's last (when it is shortened), first_h (the resumed run's
+    last step) for a resumed run's first. Records are every contact's: `contacts` have a column
+    (`columns`, Window.columns), the others none (0). t: Grid.time's product and sum."""
+    n_dof, n_contacts, n_joint = q.shape[1], N.shape[1], joint_impulse.shape[1]
+    for j in range(ks.shape[0]):
+        k, m = ks[j], m0 + j
+        r = k - k_base
+        t[m] = t_end if k == last else origin + float(k) * h
+        for d in range(n_dof):
+            q_out[m, d] = q[r, d]
+            v_out[m, d] = v[r, d]
+        for c in range(n_contacts):
+            N[m, c] = 0.0
+            T[m, c] = 0.0
+            codes[m, c] = 0
+        if r == 0:
+            for d in range(n_dof):
+                a[m, d] = np.nan
+            for c in range(contacts.shape[0]):
+                codes[m, contacts[c]] = states[0, columns[c]]
+            for d in range(n_joint):
+                joint_force[m, d] = 0.0
+            continue
+        h_k = h_last if h_last != 0.0 and k == last else h
+        if resumed and k == first:
+            h_k = first_h
+        for d in range(n_dof):
+            a[m, d] = (v[r, d] - v[r - 1, d]) / h_k
+        for c in range(contacts.shape[0]):
+            i, col = contacts[c], columns[c]
+            N[m, i] = p_normal[r - 1, col] / h_k
+            T[m, i] = p_tangent[r - 1, col] / h_k
+            codes[m, i] = states[r - 1, col]
+        for d in range(n_joint):
+            joint_force[m, d] = joint_impulse[r - 1, d] / h_k
+
+
+def compile_samples() -> None:
+    """samples_into compiled with the types a run passes it (a window's arrays and a collector's):
+    where the loop compiles, under its notice (moreau_jean.Engine.compiling), not after it."""
+    grid = Grid.of(1.0, 0.0, 1.0, None)
+    window, collector = Window(3, 1, 1), Collector(grid, 3, 1, None, None)
+    collector._samples(window, np.arange(2), True)
+
+
 class Collector:
     """The samples, state runs, boundary rows and impact rows of a run, taken window by window."""
 
@@ -313,27 +357,19 @@ class Collector:
         self._codes_before = None
         self._pending_rows = None  # (window, k_from, k_to) of the last take, until settle_rows
 
-    def step_size(self, k):
-        """Size of the steps ending at global steps k (the shortened last one, a resumed run's first)."""
-        g = self.grid
-        h = np.full(np.shape(k), g.h)
-        if g.h_last:
-            h[np.asarray(k) == g.last] = g.h_last
-        if self.resume is not None:
-            h[np.asarray(k) == g.first] = self.resume.last_h
-        return h
-
-    def take(self, window: Window, k_from: int, k_to: int, final: bool) -> None:
+    def take(self, window: Window, k_from: int, k_to: int, final: bool, compiled: bool = False) -> None:
         """Steps k_from … k_to − 1 are done (states k_from … k_to in the window); `final`: the run
-        ends at k_to."""
+        ends at k_to; `compiled`: the samples are taken by the compiled kernel (the run's steps are:
+        moreau_jean.Engine), else by its interpreted twin."""
         lo = k_from + 1 if self.n else k_from
-        if self.save_every is None and k_to >= lo:  # every step kept: lo … k_to
-            self._contiguous_samples(window, lo - window.k_base, lo, k_to + 1 - lo)
+        if self.save_every is None:  # every step kept: lo … k_to
+            ks = np.arange(lo, k_to + 1)
         else:
             ks = kept_steps(self.grid, lo, k_to, self.save_every)
             if final and (ks.size == 0 or ks[-1] != k_to):
                 ks = np.r_[ks, k_to]
-            self._samples(window, ks)
+        if ks.size:
+            self._samples(window, ks, compiled)
         if final and window.defer_rows:  # read only to locate phases: taken on first need (`settle_rows`)
             self._pending_rows = (window, k_from, k_to)
         else:
@@ -350,45 +386,17 @@ class Collector:
             self._pending_rows = None
             self._runs_and_rows(*pending)
 
-    def _samples(self, window: Window, ks: np.ndarray) -> None:
-        out, rows = window.out, ks - window.k_base
-        if ks.size and ks[-1] - ks[0] + 1 == ks.size:
-            return self._contiguous_samples(window, int(rows[0]), int(ks[0]), ks.size)
-        m = slice(self.n, self.n + ks.size)
-        self.t[m], self.q[m], self.v[m] = self.grid.time(ks), out[0][rows], out[1][rows]
-        h = self.step_size(ks)[:, None]
-        before = np.maximum(rows - 1, 0)
-        has_step = (rows >= 1)[:, None]
-        self.a[m] = np.where(has_step, (out[1][rows] - out[1][before]) / h, np.nan)
-        self.N[m] = np.where(has_step, window.full(2, before) / h, 0.0)
-        self.T[m] = np.where(has_step, window.full(3, before) / h, 0.0)
-        self.joint_force[m] = np.where(has_step, out[loop.O_JOINT_IMPULSE][before] / h, 0.0)
-        self.codes[m] = window.full(5, before)  # the first sample of a fresh run: the mode of its first step
+    def _samples(self, window: Window, ks: np.ndarray, compiled: bool) -> None:
+        """The samples of global steps ks (increasing, in the window) at the next rows (one
+        compiled call: a short run's numpy calls over a row or two cost more than its steps)."""
+        out, grid, resume = window.out, self.grid, self.resume
+        contacts, columns, _ = window.columns()
+        take = samples_into if compiled else interpreted(samples_into)
+        take(ks, window.k_base, self.n, grid.origin, grid.h, grid.last, grid.t_end, grid.h_last, grid.first,
+             grid.h if resume is None else resume.last_h, resume is not None, out[0], out[1], out[2], out[3],
+             out[5], out[loop.O_JOINT_IMPULSE], contacts, columns, self.t, self.q, self.v, self.a, self.N, self.T,
+             self.codes, self.joint_force)
         self.n += ks.size
-
-    def _contiguous_samples(self, window: Window, r0: int, k0: int, n: int) -> None:
-        """_samples of the n consecutive steps from k0, at rows from r0: slices, not gathers — the
-        same values."""
-        out, m0, joints = window.out, self.n, self.joint_force.shape[1]
-        self.grid.times_into(k0, self.t[m0: m0 + n])
-        self.q[m0: m0 + n], self.v[m0: m0 + n] = out[0][r0: r0 + n], out[1][r0: r0 + n]
-        if r0 == 0 and n:  # the run's first state: no step leads to it
-            self.a[m0], self.N[m0], self.T[m0], self.codes[m0] = np.nan, 0.0, 0.0, window.full(5, 0)
-            if joints:
-                self.joint_force[m0] = 0.0
-            m0, r0, k0, n = m0 + 1, 1, k0 + 1, n - 1
-        rows, before, m = slice(r0, r0 + n), slice(r0 - 1, r0 - 1 + n), slice(m0, m0 + n)
-        grid = self.grid
-        h = grid.h if not (grid.h_last or self.resume is not None) else self.step_size(np.arange(k0, k0 + n))[:, None]
-        a = self.a[m]
-        np.subtract(out[1][rows], out[1][before], out=a)
-        np.divide(a, h, out=a)
-        np.divide(window.full(2, before), h, out=self.N[m])
-        np.divide(window.full(3, before), h, out=self.T[m])
-        if joints:
-            np.divide(out[loop.O_JOINT_IMPULSE][before], h, out=self.joint_force[m])
-        self.codes[m] = window.full(5, before)
-        self.n = m0 + n
 
     def _runs_and_rows(self, window: Window, k_from: int, k_to: int) -> None:
         out = window.out
