@@ -48,13 +48,14 @@ class ScenePlan:
     model tuple once built (`model`, only for a scene without driven motions), and per-run arrays
     lent to one run at a time (`borrow`, `give_back`)."""
 
-    __slots__ = ("packed", "joints", "names", "varies_in_time", "python_motions", "static", "model", "_spares",
-                 "_owners", "parameters", "predicted", "predictors")
+    __slots__ = ("packed", "joints", "names", "kinds", "varies_in_time", "python_motions", "static", "model",
+                 "_spares", "_owners", "parameters", "predicted", "predictors")
 
     def __init__(self, scene):
         self.packed = pack_scene(scene)
         self.joints = pack_joints(scene.joints, len(scene.bodies))
         self.names = tuple(c.name for c in scene.contacts)
+        self.kinds = frozenset(type(c).__name__ for c in scene.contacts)  # its contacts' relation classes
         self.varies_in_time = scene.forces_vary_in_time()
         motions = self.packed.motions  # all of them when one is a Python (Prescribed) one: each step evaluates them
         self.python_motions = motions if any(isinstance(m, Prescribed) for m in motions) else []

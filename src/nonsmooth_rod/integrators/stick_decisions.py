@@ -62,7 +62,7 @@ from ..solvers.two_coefficient import STATE_NAMES
 AGREE_STEPS = 2
 # The hybrid method's contacts (hybrid.Hybrid.declares.contacts, a test checks): a scene with any
 # other is left to the step's law without importing the hybrid method (0.2 s).
-PREDICTED_CONTACTS = ("DiskOnLine",)
+PREDICTED_CONTACTS = frozenset({"DiskOnLine"})
 # A released contact's μs is lowered to μd for this many steps from the one holding the predicted
 # break-away: the first may stick still (the step that lets a contact go closes the gap it crept
 # open with a larger N, _confirm), the next slides.
@@ -87,11 +87,8 @@ def stick_decisions(scene, model, grid, plan=None, engine=None):
     """The run's StickDecisions, or None where the hybrid method does not run the scene's contacts
     (its other refusals, joints and driven things, are checked at the first prediction, and kept
     in the scene's plan for its later runs: integrators/scene_plans.py)."""
-    predicted = None if plan is None else plan.predicted  # (True: its contacts were checked before)
-    if predicted is False:
-        return None
-    if predicted is None and (not scene.contacts or any(type(c).__name__ not in PREDICTED_CONTACTS
-                                                        for c in scene.contacts)):
+    kinds = frozenset(type(c).__name__ for c in scene.contacts) if plan is None else plan.kinds
+    if not kinds or not kinds <= PREDICTED_CONTACTS or (plan is not None and plan.predicted is False):
         return None
     return StickDecisions(scene, model.contacts, grid, plan, engine)
 
