@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = '2e52d09881af884617370346729921f5'
+SOURCES = '8d3fa217205f02c0e76ec4409c8262f3'
 
 SHARES = (
     (
