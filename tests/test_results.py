@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
+import inspect
 import math
 import pickle
 
 import nonsmooth_rod as nr
 from nonsmooth_rod import toys
+from nonsmooth_rod.results import SimulationResult, Status
 
 
 def ball_run():
@@ -29,3 +32,22 @@ def test_a_value_set_before_any_read_is_kept():
     run = ball_run()
     run.phases = {"floor": []}
     assert run.phases == {"floor": []} and any(e.kind == "impact" for e in run.events)
+
+
+def test_the_constructor_takes_every_field_in_order_and_keeps_each_value():
+    """SimulationResult.__init__ is written by hand (it fills the deferred fields' slots directly):
+    it must take the dataclass's fields, in order, and give each back."""
+    names = [f.name for f in dataclasses.fields(SimulationResult)]
+    assert list(inspect.signature(SimulationResult).parameters) == names
+    values = {name: object() for name in names}
+    values["status"] = Status.STOPPED
+    result = SimulationResult(**values)
+    assert all(getattr(result, name) is value for name, value in values.items())
+    assert SimulationResult(*values.values()) == result
+
+
+def test_fields_left_out_are_each_result_s_own_empty_lists_and_dicts():
+    one, two = (SimulationResult("moreau-jean", "ok", "", None, []) for _ in range(2))
+    assert one.status is Status.OK and one.end_state is None and one.setup is None
+    for name in ("events", "impacts", "phases", "stats", "joint_forces"):
+        assert getattr(one, name) == type(getattr(one, name))() and getattr(one, name) is not getattr(two, name)

@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = '4a9e7e6bf212879d3b13840b12fbf6cf'
+SOURCES = '50e171e863438a9a49e0391e954bc333'
 
 SHARES = (
     (

@@ -637,9 +637,10 @@ class MoreauJean:
         return impacts, events
 
     def _result(self, scene, packed, grid, window, collector, work, ending, names, cpu, stats) -> SimulationResult:
+        """The run's result (`stats`: the run's own dict, completed here with the loop's counts)."""
         run_status, k_end = ending
         status, message, final_event = self._ending(run_status, k_end, grid, window, names)
-        impacts, events = self._impacts(scene, grid, collector, names)
+        impacts, events = self._impacts(scene, grid, collector, names) if collector.impact_rows else ([], [])
         counters = window.out.counters
         t, q, v, a, N, T, codes = collector.trajectory_arrays()
         modes = _STATE_WORDS.take(codes)
@@ -657,10 +658,10 @@ class MoreauJean:
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
         n_done, counts = k_end - grid.first, counters.tolist()
-        stats = dict(stats, steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
-                     inconsistent_steps=counts[loop.K_INCONSISTENT], solver_fallbacks=counts[loop.K_FALLBACKS],
-                     steps_at_rest=counts[loop.K_REPEATED],
-                     unresolved_impacts=len(collector.impact_rows) - len(impacts))
+        stats["steps"], stats["solves"] = n_done, counts[loop.K_SOLVES]
+        stats["solver_iterations"], stats["inconsistent_steps"] = counts[loop.K_ITERATIONS], counts[loop.K_INCONSISTENT]
+        stats["solver_fallbacks"], stats["steps_at_rest"] = counts[loop.K_FALLBACKS], counts[loop.K_REPEATED]
+        stats["unresolved_impacts"] = len(collector.impact_rows) - len(impacts)
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
                                   impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
         result.defer(locate)

@@ -350,7 +350,8 @@ class Collector:
         self.N, self.T = np.empty((n, n_contacts)), np.empty((n, n_contacts))
         self.codes = np.zeros((n, n_contacts), dtype=np.int8)
         self.n = 0
-        self.runs: list[list[tuple[int, int]]] = [[] for _ in range(n_contacts)]  # (first step, code)
+        # each contact's runs of one state, (first step, code): made when the first rows are taken
+        self.runs: list[list[tuple[int, int]]] = []
         self._blocks: list[tuple] = []  # (steps, q, v, p_normal, p_tangent, states, records valid) around changes
         self._index = None
         self.impact_rows: list[tuple] = []  # (step, contact, t, q_k, v_k, v_k+1, p_n, p_t)
@@ -407,7 +408,7 @@ class Collector:
             return
         owner = window.owners()  # the contact of each column given
         codes = codes[:, :owner.size]  # (a view: the columns given)
-        n, k0 = len(self.runs), window.k_base + r_lo
+        n, k0 = self.N.shape[1], window.k_base + r_lo
         before = np.zeros(n, dtype=codes.dtype) if first else self._codes_before  # every contact's
         changed = np.empty(codes.shape, dtype=bool)
         np.not_equal(codes[1:], codes[:-1], out=changed[1:])
@@ -415,8 +416,7 @@ class Collector:
         if first:  # every contact's first run starts here (one without a column: open)
             start = before.copy()
             start[owner] = codes[0]
-            for i in range(n):
-                self.runs[i].append((k0, int(start[i])))
+            self.runs = [[(k0, code)] for code in start.tolist()]
             changed[0] = False
         at, columns = np.nonzero(changed)  # every change, by row then column (a row of balls: ~100 a run)
         for i, k, code in zip(owner[columns].tolist(), (at + k0).tolist(), codes[at, columns].tolist()):
@@ -462,7 +462,7 @@ class Collector:
         """The kept rows by step, each block's records spread over the columns the last has (a
         column is never taken back: the last block's columns hold every earlier one's)."""
         every = self._blocks[-1][-1] if self._blocks else np.zeros(0, dtype=np.int64)
-        self._position = np.full(len(self.runs), -1)
+        self._position = np.full(self.N.shape[1], -1)
         self._position[every] = np.arange(every.size)
         blocks = [b[:3] + tuple(_spread(a, self._position[b[-1]], every.size) for a in b[3:6]) + (b[6],)
                   for b in self._blocks]
@@ -476,7 +476,10 @@ class Collector:
     def _impacts(self, window: Window) -> None:
         out = window.out
         counters = out[9]
-        for n in range(int(counters[loop.K_N_IMPACTS])):
+        count = int(counters[loop.K_N_IMPACTS])
+        if not count:  # (most windows of a short run)
+            return
+        for n in range(count):
             r, i = int(out[7][n]), int(out[8][n])
             self.impact_rows.append((window.k_base + r, i, float(out[6][n]), out[0][r].copy(), out[1][r].copy(),
                                      out[1][r + 1].copy(), np.array(window.full(2, r)), np.array(window.full(3, r))))
