@@ -20,7 +20,7 @@ from . import _jit
 from .integrators import METHODS, MAX_OUTPUT_BYTES, check_output_size, integrator_class
 from .model.scene import Scene
 from .results import SimulationResult
-from .validation import InputError, quoted, require_finite, require_positive, require_state
+from .validation import InputError, quoted, require_finite, require_positive, require_states
 
 
 @dataclass(frozen=True)
@@ -70,10 +70,9 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     """
     if not isinstance(scene, Scene):
         raise InputError(f"scene must be a nonsmooth_rod.Scene, got {type(scene).__name__}")
-    q0 = require_state("q0", q0, scene.n_dof)
-    v0 = require_state("v0", v0, scene.n_dof)
-    t0 = require_finite("t0", t0)
-    t_end = require_finite("t_end", t_end)
+    q0, v0 = require_states(q0, v0, scene.n_dof)
+    t0 = t0 if type(t0) is float and math.isfinite(t0) else require_finite("t0", t0)  # (a float: no call)
+    t_end = t_end if type(t_end) is float and math.isfinite(t_end) else require_finite("t_end", t_end)
     if t_end <= t0:
         raise InputError(f"t_end must be later than t0 = {t0:g}, got {t_end!r}")
     if save_every is not None:

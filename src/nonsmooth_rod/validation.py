@@ -193,6 +193,19 @@ def require_state(name: str, value, n_dof: int):
     return array
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
+def require_states(q0, v0, n_dof: int):
+    """(q0, v0) checked as require_state checks each: two small float64 arrays (a call's common
+    case) by one bound on both, the rest one by one."""
+    if (type(q0) is np.ndarray and type(v0) is np.ndarray and q0.dtype is _FLOAT64 and v0.dtype is _FLOAT64
+            and q0.shape == v0.shape == (n_dof,) and n_dof <= 32
+            and sum(map(abs, q0.tolist())) + sum(map(abs, v0.tolist())) <= MAX_STATE):  # (NaN, inf fail it)
+        return q0.copy(), v0.copy()
+    return require_state("q0", q0, n_dof), require_state("v0", v0, n_dof)
+
+
 # --- declared checks of options dataclasses ----------------------------------------------------
 
 def _bound(x: float) -> str:

@@ -186,8 +186,8 @@ def test_kept_plans_are_bounded():
 def test_the_arrays_a_plan_lends_are_bounded():
     """A few sets (runs of many lengths do not pile up windows), each small (a long run's window is
     not kept)."""
-    from nonsmooth_rod.integrators.moreau_jean import _lend_window
-    from nonsmooth_rod.integrators.moreau_jean_records import Window
+    from nonsmooth_rod.integrators.moreau_jean import _lend, _new_work
+    from nonsmooth_rod.integrators.moreau_jean_records import HISTORY, Window
 
     scene = ball_scene()
     kept = [nr.simulate(scene, Q0, V0, steps * H, h=H) for steps in range(5, 5 + 3 * scene_plans.MAX_SPARES)]
@@ -195,9 +195,9 @@ def test_the_arrays_a_plan_lends_are_bounded():
     plan = scene_plan(scene)
     assert len(plan._spares) == scene_plans.MAX_SPARES
     long_window = Window(scene.n_dof, 1, 50_000)
-    _lend_window(plan, long_window)
+    _lend(plan, None, _new_work(1, scene.n_dof, plan.joints), long_window)
     assert long_window.rows not in plan._spares
     del kept  # their results gone: every set free
-    taken = [plan.borrow("work") for _ in range(scene_plans.SETS_PER_KEY)]
-    assert all(t is not None for t in taken) and plan.borrow("work") is None  # each set to one run at a time
+    taken = [plan.borrow(HISTORY + 5) for _ in range(scene_plans.SETS_PER_KEY)]
+    assert all(t is not None for t in taken) and plan.borrow(HISTORY + 5) is None  # each set to one run at a time
     assert len({id(t) for t in taken}) == scene_plans.SETS_PER_KEY

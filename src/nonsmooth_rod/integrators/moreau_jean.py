@@ -165,13 +165,10 @@ def driven_start(packed, q0, v0, t0: float):
     return origin, v0
 
 
-WORK_KEY = "work"  # the Work a scene's plan lends to its runs
-
-
-def _run_data(plan, q0, v0, grid: Grid, resume):
+def _run_data(plan, q0, v0, grid: Grid, resume, lent):
     """(model, work, v0) of a run: the plan's model when the scene has no driven motion (else one
     with their origins, and v0 with the driven bodies' prescribed velocities), and a zeroed Work
-    lent by the plan or new, with the contact memory of `resume`."""
+    (of the set `lent` by the plan, or new), with the contact memory of `resume`."""
     if plan.static:
         if plan.model is None:
             plan.model = _model(plan.packed, None, plan.joints)
@@ -179,15 +176,14 @@ def _run_data(plan, q0, v0, grid: Grid, resume):
     else:
         origin, v0 = driven_start(plan.packed, q0, v0, float(grid.time(grid.first)))
         model = _model(plan.packed, origin, plan.joints)
-    work = plan.borrow(WORK_KEY)
-    if work is None:
-        work = _new_work(plan.packed.n_contacts, plan.packed.minv.shape[0], plan.joints)
+    work = lent[0] if lent is not None else _new_work(plan.packed.n_contacts, plan.packed.minv.shape[0], plan.joints)
     _restore_memory(work, resume)
     return model, work, v0
 
 
-# A window's records a scene's plan lends to its next run, up to this size (a short run's: zeroing
-# a long window's rows again would cost more than new zeroed pages, and a plan keeps them).
+# A run's Work and window records a scene's plan lends to its next run of as many rows, up to this
+# size (a short run's: zeroing a long window's rows again would cost more than new zeroed pages,
+# and a plan keeps them). One set, one borrow and one return a run (each ~1 µs of a short call).
 LENT_WINDOW_BYTES = 1 << 18
 
 
@@ -198,15 +194,14 @@ LENT_WINDOW_BYTES = 1 << 18
 RECORD_COLUMNS_PER_BODY, MIN_RECORD_COLUMNS = 4, 16
 
 
-def _window(plan, n_dof: int, n_contacts: int, chunk: int, joint_rows: int, slip_default) -> Window:
-    """The run's window: with the records an earlier run of the scene lent (zeroed), or new, with
-    a column of records for the contacts that are candidates (moreau_jean_loop.new_records)."""
+def _window(n_dof: int, n_contacts: int, chunk: int, joint_rows: int, slip_default, lent, work) -> Window:
+    """The run's window: with the records of the set an earlier run of the scene `lent` (zeroed),
+    or new, with a column of records for the contacts that are candidates (new_records)."""
     columns = max(MIN_RECORD_COLUMNS, RECORD_COLUMNS_PER_BODY * (n_dof // 3))
-    lent = plan.borrow(HISTORY + chunk)
-    window = Window(n_dof, n_contacts, chunk, joint_rows, lent, columns, slip_default)
+    window = Window(n_dof, n_contacts, chunk, joint_rows, None if lent is None else lent[1], columns, slip_default)
     # a window small enough to lend leaves its last rows to be taken on first need (Collector.settle_rows:
     # its result then holds it); a larger one has them taken in the run, as its result's end state
-    window.defer_rows = lent is not None or sum(a.nbytes for a in window.out) <= LENT_WINDOW_BYTES
+    window.defer_rows = lent is not None or sum(a.nbytes for a in (*work, *window.out)) <= LENT_WINDOW_BYTES
     return window
 
 
@@ -222,10 +217,12 @@ def _same_float(a: float, b: float) -> bool:
     return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
 
 
-def _lend_window(plan, window: Window, holder=None) -> bool:
-    """The window's records back to the scene's plan, for its next run of as many rows, when small;
-    True if lent (`holder`: the result whose end state is built from them on first read)."""
-    return plan.give_back(window.rows, window.out, LENT_WINDOW_BYTES, holder)
+def _lend(plan, lent, work, window: Window, holder=None) -> bool:
+    """The run's Work and window records back to the scene's plan, for its next run of as many
+    rows, when small; True if lent (`holder`: the result whose end state is built from them on
+    first read). The set `lent` itself when the run kept it (the plan knows its buffers)."""
+    kept = lent if lent is not None and lent[1] is window.out else (work, window.out)
+    return plan.give_back(window.rows, kept, LENT_WINDOW_BYTES, holder)
 
 
 def _chunk_size(grid: Grid, stopping: bool) -> int:
@@ -269,6 +266,12 @@ _LOOP_IN_WORDS = f"the Moreau–Jean loop ({', '.join(EXACT_SOLVERS)})"
 
 
 _NOTHING = contextlib.nullcontext()  # (reusable: it holds nothing)
+# A run of at least this many steps holds BLAS to one thread (_jit.one_blas_thread: the hold
+# search's small SVDs once woke OpenBLAS's thread pool, which then slowed the steps and whatever
+# ran next). A shorter one leaves it as it is: setting and restoring the limit costs ~1 yardstick,
+# more than its few LAPACK calls can lose (the row of 16 balls and the 4- and 8-row piles measured
+# the same without the limit, 2026-11-26: docs/performance.md).
+BLAS_LIMIT_STEPS = 64
 NO_EXTRA_FORCE = np.zeros(0)  # run_steps' `extra` when no Python force is called back
 _DIRECT = DirectEntry()  # run_steps without numba's overload search for the model, work, records it knows
 
@@ -358,9 +361,10 @@ class MoreauJean:
         plan = scene_plan(scene)  # packed once for the runs that repeat the scene
         packed, names = plan.packed, list(plan.names)
         grid, params, iparams, slip_default = self._run_parameters(plan, scene, t0, t_end, resume, names)
-        model, work, v0 = _run_data(plan, q0, v0, grid, resume)
-        window = _window(plan, scene.n_dof, len(names), _chunk_size(grid, bool(stop)), ROWS_PER_JOINT * len(scene.joints),
-                         slip_default)
+        chunk = _chunk_size(grid, bool(stop))
+        lent = plan.borrow(HISTORY + chunk)  # (Work, Records) of an earlier run of as many rows, zeroed
+        model, work, v0 = _run_data(plan, q0, v0, grid, resume, lent)
+        window = _window(scene.n_dof, len(names), chunk, ROWS_PER_JOINT * len(scene.joints), slip_default, lent, work)
         window.seed(q0, v0, grid.first, resume)
         collector = Collector(grid, scene.n_dof, len(names), save_every, resume, ROWS_PER_JOINT * len(scene.joints))
         solver_code = SOLVER_CODES.get(opts.solver)
@@ -371,7 +375,7 @@ class MoreauJean:
         self._solver_error = None
         wall = time.process_time()
         decisions = stick_decisions(scene, model, grid, plan, engine)
-        with _jit.one_blas_thread():  # the hold search's small SVDs: no thread pool to wake (_jit)
+        with _jit.one_blas_thread() if grid.n_steps >= BLAS_LIMIT_STEPS else _NOTHING:
             ending = self._windows(engine, scene, grid, window, collector, params, iparams, model, work, list(stop),
                                    decisions)
         cpu = time.process_time() - wall
@@ -383,8 +387,7 @@ class MoreauJean:
         # lent to the next run of the scene, which first has the result copy its end state out of
         # them if it is still alive (a loop that drops each result never copies); a window too
         # large to lend is not kept alive by the result: its end state is copied now
-        plan.give_back(WORK_KEY, work, holder=result)
-        if not _lend_window(plan, window, result):
+        if not _lend(plan, lent, work, window, result):
             result.settle_end_state()
         return result
 

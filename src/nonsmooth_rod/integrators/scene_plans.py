@@ -14,8 +14,8 @@ hands the same plan back while nothing the packing read has changed:
   LinearRelation's or a LinearJoint's dict rows) or with driven obstacles or bodies (the loop
   writes their rows while it runs) is packed again for every run, as before.
 
-The per-run arrays a plan lends (the loop's `Work`, a short run's window `Records`: a few sets,
-each small) go to one run at a time and come back zeroed; nothing a result keeps points into them.
+The per-run arrays a plan lends (a short run's `Work` and window `Records`, lent as one set; a few
+sets, each small) go to one run at a time and come back zeroed; nothing a result keeps points into them.
 Plans and what they lend are per process: a study's workers each pack their scene once.
 """
 from __future__ import annotations
@@ -35,7 +35,7 @@ from .carved import owners
 # packing is a small part of any run, and the arrays are not worth keeping.
 MAX_PLANS = 8
 MAX_PLAN_CONTACTS = 4096
-# Sets of per-run arrays a plan lends (the Work, windows of a few lengths).
+# Sets of per-run arrays a plan lends (a run's Work and window records, for windows of a few lengths).
 MAX_SPARES = 4
 SETS_PER_KEY = 2  # sets lent a key: the last result can keep its arrays while the next run takes the other
 _PLANS: dict = {}  # id(scene) → (scene, fingerprint, what the fingerprint's ids name, plan, checked)
@@ -93,8 +93,9 @@ class ScenePlan:
         return arrays
 
     def give_back(self, key, arrays, max_bytes: float = float("inf"), holder=None) -> bool:
-        """Lend `arrays` to the next run that asks for `key` (SETS_PER_KEY sets a key, MAX_SPARES
-        keys), when they hold at most `max_bytes`; True if lent. `holder`: the result whose end
+        """Lend `arrays` (a set: sequences of arrays, the loop's tuples) to the next run that asks
+        for `key` (SETS_PER_KEY sets a key, MAX_SPARES keys), when they hold at most `max_bytes`;
+        True if lent. `holder`: the result whose end
         state is built from them on first read (settled before they are lent again, if it is
         alive): two sets a key, so that a loop that keeps each result until the next call returns
         never has one copied."""
@@ -102,7 +103,7 @@ class ScenePlan:
         if known is None or known[0] is not arrays:  # the same sets come back run after run
             if len(self._owners) >= SETS_PER_KEY * MAX_SPARES:
                 self._owners.clear()
-            buffers = owners(arrays)
+            buffers = owners([a for part in arrays for a in part])
             known = self._owners[id(arrays)] = (arrays, buffers, sum(b.nbytes for b in buffers))
         if known[2] > max_bytes:
             return False
