@@ -100,10 +100,17 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     return result
 
 
+_KNOWN_METHODS: dict = {}  # method name → its integrator class, once asked for
+
+
 def _integrator_class(method):
+    known = _KNOWN_METHODS.get(method) if type(method) is str else None
+    if known is not None:
+        return known
     if not isinstance(method, str) or method not in METHODS:
         raise InputError(f"unknown method {quoted(method)}; choose from: {', '.join(METHODS)}")
-    return integrator_class(method)
+    known = _KNOWN_METHODS[method] = integrator_class(method)
+    return known
 
 
 def _check_contacts(method: str, declared, scene: Scene) -> None:

@@ -321,6 +321,20 @@ def _prepare_loop(log) -> None:
     compile_samples()
 
 
+_WARM_ENGINES: dict = {}  # part → its Engine once warm: compiled, probing nothing, it holds no run's state
+
+
+def run_engine(compiled: bool, part: str, what: str, job: list) -> Engine:
+    """A run's Engine: the part's shared one while its compiled kernels are warm (a set lookup:
+    _jit.engine_is_warm), else a new one (it may probe, then compile or go on interpreted)."""
+    if compiled and _jit.engine_is_warm(part):
+        engine = _WARM_ENGINES.get(part)
+        if engine is None:
+            engine = _WARM_ENGINES[part] = Engine(compiled, part, what, job)
+        return engine
+    return Engine(compiled, part, what, job)
+
+
 # The endings of a chunk of steps whose break-aways are reviewed (stick_decisions): every step
 # of it done (a stop at an impact included: a break-away before it may move the impact)
 REVIEWED = (loop.RUN_OK, loop.RUN_STOPPED)
@@ -371,7 +385,7 @@ class MoreauJean:
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
         self._motions_in_python = plan.python_motions
         self._calls_back = scene.applied_force is not None or bool(self._motions_in_python)
-        engine = Engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
+        engine = run_engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
         self._solver_error = None
         wall = time.process_time()
         decisions = stick_decisions(scene, model, grid, plan, engine)

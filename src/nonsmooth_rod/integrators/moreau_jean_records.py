@@ -28,7 +28,7 @@ import numpy as np
 
 from ..solvers._common import interpreted
 from . import moreau_jean_loop as loop
-from .kept_samples import samples_into
+from .kept_samples import compiled_samples, samples_into
 from .sampling import save_slots
 
 # Rows of records a window keeps from the steps before its first: the warm start reads one, the
@@ -304,7 +304,7 @@ class Collector:
         self.grid, self.save_every, self.resume = grid, save_every, resume
         self.t, self.q, self.v, self.a = np.empty(n), np.empty((n, n_dof)), np.empty((n, n_dof)), np.empty((n, n_dof))
         self.N, self.T = np.empty((n, n_contacts)), np.empty((n, n_contacts))
-        self.codes = np.zeros((n, n_contacts), dtype=np.int8)
+        self.codes = np.empty((n, n_contacts), dtype=np.int8)  # (every row written by samples_into)
         self.n = 0
         # each contact's runs of one state, (first step, code): made when the first rows are taken
         self.runs: list[list[tuple[int, int]]] = []
@@ -348,7 +348,7 @@ class Collector:
         compiled call: a short run's numpy calls over a row or two cost more than its steps)."""
         out, grid, resume = window.out, self.grid, self.resume
         contacts, columns, _ = window.columns()
-        take = samples_into if compiled else interpreted(samples_into)
+        take = compiled_samples() if compiled else interpreted(samples_into)
         take(ks, window.k_base, self.n, grid.origin, grid.h, grid.last, grid.t_end, grid.h_last, grid.first,
              grid.h if resume is None else resume.last_h, resume is not None, out[0], out[1], out[2], out[3],
              out[5], out[loop.O_JOINT_IMPULSE], contacts, columns, self.t, self.q, self.v, self.a, self.N, self.T,
