@@ -469,12 +469,12 @@ class MoreauJean:
                 window.slide()
             last = bool(grid.h_last) and k == grid.last - 1
             n = engine.steps(1 if last else min(window.room(), grid.first + grid.n_full - k))
-            n = n if decisions is None else decisions.steps(k, n)
+            held, taken_back = _NOTHING, False
+            if decisions is not None:  # cut at the holds it plans, run in them
+                n, held, taken_back = decisions.chunk(window, k, n)
             step_params = self._shortened(params, grid, window, k) if last else params
             params[loop.P_K0] = window.k_base
-            taken_back = stops or (decisions is not None and decisions.may_take_back(window, k, n))
-            snapshot = _snapshot(work, window) if taken_back else None
-            held = _NOTHING if decisions is None else decisions.holding(k)
+            snapshot = _snapshot(work, window) if stops or taken_back else None
             started = time.perf_counter() if engine.probing else None
             with held:
                 status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
@@ -605,7 +605,9 @@ class MoreauJean:
     def _ending(self, status, k_end, grid, window, names):
         """(status word, message, solver-failure event or None) of how the run ended at step k_end."""
         if status == loop.RUN_OK:
-            return Status.OK, f"reached t_end = {grid.t_end:g} s", None
+            if grid.reached is None:
+                grid.reached = f"reached t_end = {grid.t_end:g} s"
+            return Status.OK, grid.reached, None
         if status == loop.RUN_STOPPED:
             return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
         out = window.out
@@ -675,10 +677,9 @@ class MoreauJean:
             result.phases = phases
             result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
         n_done, counts = k_end - grid.first, counters.tolist()
-        stats["steps"], stats["solves"] = n_done, counts[loop.K_SOLVES]
-        stats["solver_iterations"], stats["inconsistent_steps"] = counts[loop.K_ITERATIONS], counts[loop.K_INCONSISTENT]
-        stats["solver_fallbacks"], stats["steps_at_rest"] = counts[loop.K_FALLBACKS], counts[loop.K_REPEATED]
-        stats["unresolved_impacts"] = len(collector.impact_rows) - len(impacts)
+        stats.update(steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
+                     inconsistent_steps=counts[loop.K_INCONSISTENT], solver_fallbacks=counts[loop.K_FALLBACKS],
+                     steps_at_rest=counts[loop.K_REPEATED], unresolved_impacts=len(collector.impact_rows) - len(impacts))
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
                                   impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
         result.defer(locate)

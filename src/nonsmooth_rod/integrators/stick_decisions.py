@@ -117,21 +117,20 @@ class StickDecisions:
         self.predictions = 0
         self._ahead: dict = {}  # a mode run's first step → its prediction (each contact's break-away reads it)
 
-    def steps(self, k: int, n: int) -> int:
-        """n steps from step k, cut so that a chunk starts at every planned hold's and release's
-        first and last step."""
-        if not (self.held or self.released):
-            return n  # (a run without holds: every call's first chunk)
-        bounds = [b for plan in (self.held, self.released) for span in plan.values() for b in span]
-        return min([n] + [b - k for b in bounds if b > k])
-
-    def holding(self, k: int):
-        """The context the chunk from step k runs in: its held contacts' friction raised in the
-        packed table, its released ones' μs lowered to μd (restored after)."""
-        if not (self.held or self.released):
-            return _NO_HOLDS
-        held, released = _during(self.held, k), _during(self.released, k)
-        return self.smooth.Held(self.table, held, released) if held or released else _NO_HOLDS
+    def chunk(self, window, k: int, n: int):
+        """(steps, context, whether the review may take steps back) of the chunk from step k of
+        at most n steps: cut so that a chunk starts at every planned hold's and release's first
+        and last step; run in its held contacts' friction raised in the packed table and its
+        released ones' μs lowered to μd (restored after); the review compares the modes of
+        consecutive rows from the one before the chunk's (a run's first chunk of one step has no two)."""
+        if self.held or self.released:
+            bounds = [b for plan in (self.held, self.released) for span in plan.values() for b in span]
+            n = min([n] + [b - k for b in bounds if b > k])
+            held, released = _during(self.held, k), _during(self.released, k)
+            context = self.smooth.Held(self.table, held, released) if held or released else _NO_HOLDS
+        else:  # (a run without holds: every call's first chunk)
+            context = _NO_HOLDS
+        return n, context, self.handled and (n > 1 or k > window.k_base)
 
     def review(self, window, k: int, k_done: int) -> int | None:
         """The step the chunk's steps k … k_done − 1 are taken back to (its records and state from
@@ -163,12 +162,6 @@ class StickDecisions:
             start = r
         self._start(window, start)
         return None
-
-    def may_take_back(self, window, k: int, n: int) -> bool:
-        """Whether the review of a chunk of n steps from step k can take steps back (it compares
-        the modes of consecutive rows from the one before the chunk's: a run's first chunk of one
-        step has no two)."""
-        return self.handled and (n > 1 or k > window.k_base)
 
     def _start(self, window, r: int) -> None:
         """Row r of the window starts a run of modes: read from the window on first need, or
