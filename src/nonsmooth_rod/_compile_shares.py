@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = '2dcbb176fdfd97f98e7b26e1767ae250'
+SOURCES = 'f5ca822f6f031c706ec68c1a4910649f'
 
 SHARES = (
     (

@@ -17,6 +17,7 @@ impulses on the start velocity, O(h²) for a persistent contact (docs/friction.m
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import time
 from dataclasses import dataclass
@@ -476,8 +477,7 @@ class MoreauJean:
             params[loop.P_K0] = window.k_base
             snapshot = _snapshot(work, window) if stops or taken_back else None
             started = time.perf_counter() if engine.probing else None
-            with held:
-                status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work)
+            status, k_done = self._advance(engine, scene, window, n, step_params, iparams, model, work, held)
             if started is not None:
                 engine.measured(k_done - k, time.perf_counter() - started, grid.last - k_done, status)
             k_back = decisions.review(window, k, k_done) if decisions and status in REVIEWED else None
@@ -505,8 +505,7 @@ class MoreauJean:
         window.out.counters[:] = snapshot[1]
         window.r = k - window.k_base
         if k_to > k:
-            with held:
-                self._advance(engine, scene, window, k_to - k, *arrays)
+            self._advance(engine, scene, window, k_to - k, *arrays, held)
         return k_to
 
     @staticmethod
@@ -516,26 +515,35 @@ class MoreauJean:
         p[loop.P_H], p[loop.P_T0], p[loop.P_K0] = grid.h_last, grid.origin + float(k) * grid.h, -float(k - window.k_base)
         return p
 
-    def _advance(self, engine, scene, window, n, params, iparams, model, work):
+    def _advance(self, engine, scene, window, n, params, iparams, model, work, held=_NOTHING):
         """n steps from the window's current row with the engine's kernels (compiled, or their
-        interpreted twins), the window's records widened whenever a new candidate finds their
-        columns taken; returns (run status, global step reached)."""
-        r0 = r = window.r
+        interpreted twins) in the context `held` (the chunk's holds: stick_decisions); returns
+        (run status, global step reached)."""
+        r0 = window.r
         window.out.counters[loop.K_DONE] = r0
-        kernels = engine.kernels
-        with engine.compiling():
-            while True:
-                out = window.out
-                if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
-                    status = _DIRECT.run_steps(kernels, r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
-                else:
-                    status = self._run_stepwise(kernels, scene, r, r0 + n, params, iparams, model, work, out)
-                if status != loop.RUN_RECORDS_SHORT:
-                    break
-                window.widen()  # and step K_DONE again, from its start
-                r = int(window.out.counters[loop.K_DONE])
+        compiling = engine.compiling()
+        if held is _NOTHING and compiling is _NOTHING:  # (most chunks: no context's Python calls)
+            status = self._steps(engine.kernels, scene, window, r0, n, params, iparams, model, work)
+        else:
+            with held, compiling:
+                status = self._steps(engine.kernels, scene, window, r0, n, params, iparams, model, work)
         window.r = int(window.out.counters[loop.K_DONE])
         return int(status), window.k_base + window.r
+
+    def _steps(self, kernels, scene, window, r0, n, params, iparams, model, work):
+        """Steps r0 … r0 + n − 1 of the window, its records widened whenever a new candidate finds
+        their columns taken (and that step run again); returns the run status."""
+        r = r0
+        while True:
+            out = window.out
+            if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
+                status = _DIRECT.run_steps(kernels, r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
+            else:
+                status = self._run_stepwise(kernels, scene, r, r0 + n, params, iparams, model, work, out)
+            if status != loop.RUN_RECORDS_SHORT:
+                return status
+            window.widen()  # and step K_DONE again, from its start
+            r = int(window.out.counters[loop.K_DONE])
 
     def _first_hold(self, stops, collector, window, k_from, k_to):
         """The first kept step in (k_from, k_to] where a stop condition holds, or None."""
@@ -658,7 +666,10 @@ class MoreauJean:
     def _result(self, scene, packed, grid, window, collector, work, ending, names, cpu, stats) -> SimulationResult:
         """The run's result (`stats`: the run's own dict, completed here with the loop's counts)."""
         run_status, k_end = ending
-        status, message, final_event = self._ending(run_status, k_end, grid, window, names)
+        if run_status == loop.RUN_OK and grid.reached is not None:  # (the common ending, its message known)
+            status, message, final_event = Status.OK, grid.reached, None
+        else:
+            status, message, final_event = self._ending(run_status, k_end, grid, window, names)
         impacts, events = self._impacts(scene, grid, collector, names) if collector.impact_rows else ([], [])
         counters = window.out.counters
         t, q, v, a, N, T, codes = collector.trajectory_arrays()
@@ -668,21 +679,14 @@ class MoreauJean:
         t_stop = None
         if run_status == loop.RUN_STOPPED:
             t_stop = max(i.t for i in impacts if i.contact == self.options.stop_at_impact)
-        min_phase, predicted = self.options.min_phase, self._predicted_switches
-
-        def locate(result):  # on first use of result.phases or result.events
-            collector.settle_rows()
-            phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop,
-                                                  predicted)
-            result.phases = phases
-            result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
         n_done, counts = k_end - grid.first, counters.tolist()
         stats.update(steps=n_done, solves=counts[loop.K_SOLVES], solver_iterations=counts[loop.K_ITERATIONS],
                      inconsistent_steps=counts[loop.K_INCONSISTENT], solver_fallbacks=counts[loop.K_FALLBACKS],
                      steps_at_rest=counts[loop.K_REPEATED], unresolved_impacts=len(collector.impact_rows) - len(impacts))
         result = SimulationResult(self.name, status, message, Trajectory(t, q, v, a, N, T, modes), names, [],
                                   impacts, {}, steps=n_done, cpu_time_s=cpu, stats=stats)
-        result.defer(locate)
+        result.defer(functools.partial(_locate, scene, collector, packed, impacts, grid, k_end, self.options.min_phase,
+                                       t_stop, self._predicted_switches, events, final_event))
         if status == "failed":  # located now: a failed run's contacts may not bear evaluating later
             result._settle()
         if scene.joints:
@@ -693,11 +697,23 @@ class MoreauJean:
         if status == "failed":
             result.end_state = None
         else:  # built on first read (run() settles it before its arrays are reused), the rows with it
-            def end_state():
-                collector.settle_rows()
-                return window.resume_state(grid, work, last_h, on_grid)
-            result.build_end_state(end_state)
+            result.build_end_state(functools.partial(_end_state, collector, window, grid, work, last_h, on_grid))
         return result
+
+
+def _locate(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop, predicted, events, final_event,
+            result) -> None:
+    """A run's phases and events, on first use of result.phases or result.events (SimulationResult.defer)."""
+    collector.settle_rows()
+    phases, phase_events = located_phases(scene, collector, packed, impacts, grid, k_end, min_phase, t_stop, predicted)
+    result.phases = phases
+    result.events = sorted(events + phase_events, key=lambda e: e.t) + ([final_event] if final_event else [])
+
+
+def _end_state(collector, window, grid, work, last_h, on_grid) -> ResumeState:
+    """A run's end state, on its first read (SimulationResult.build_end_state), the rows with it."""
+    collector.settle_rows()
+    return window.resume_state(grid, work, last_h, on_grid)
 
 
 def _tol_with_joints_or_driven(scene, options, duration) -> dict | None:
