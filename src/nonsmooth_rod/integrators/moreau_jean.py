@@ -291,6 +291,7 @@ class Engine:
         self.probing = compiled and not _jit.engine_is_warm(part) and _jit.compile_policy() == "auto"
         self.compiled = compiled and not self.probing  # the kernels are numba's (not the interpreted twins)
         self.kernels = loop_kernels(self.compiled)
+        self.warm = self.compiled and _jit.engine_is_warm(part)  # compiled and in the cache: no notice, ever
 
     def steps(self, n: int) -> int:
         """How many of the n steps the next call may run (the probe's, while probing)."""
@@ -386,6 +387,7 @@ class MoreauJean:
         # a step needs Python: a Python applied_force or a Python (Prescribed) motion
         self._motions_in_python = plan.python_motions
         self._calls_back = scene.applied_force is not None or bool(self._motions_in_python)
+        self._whole_loop = not self._calls_back and solver_code is not None  # one compiled call a chunk
         engine = run_engine(bool(opts.fast and _jit.ENABLED), *compiled_part(opts.solver, solver_code, self._calls_back))
         self._solver_error = None
         wall = time.process_time()
@@ -521,7 +523,7 @@ class MoreauJean:
         (run status, global step reached)."""
         r0 = window.r
         window.out.counters[loop.K_DONE] = r0
-        compiling = engine.compiling()
+        compiling = _NOTHING if engine.warm else engine.compiling()
         if held is _NOTHING and compiling is _NOTHING:  # (most chunks: no context's Python calls)
             status = self._steps(engine.kernels, scene, window, r0, n, params, iparams, model, work)
         else:
@@ -536,7 +538,7 @@ class MoreauJean:
         r = r0
         while True:
             out = window.out
-            if not self._calls_back and iparams[loop.I_SOLVER] >= 0:
+            if self._whole_loop:
                 status = _DIRECT.run_steps(kernels, r, r0 + n, params, iparams, model, work, out, NO_EXTRA_FORCE)
             else:
                 status = self._run_stepwise(kernels, scene, r, r0 + n, params, iparams, model, work, out)

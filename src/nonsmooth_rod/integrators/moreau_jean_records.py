@@ -42,6 +42,7 @@ WORK_CLOSED, WORK_GRAZING, WORK_SLIP_SIGN = 5, 6, 7
 RECORDS = ("p_normal", "p_tangent", "slip", "states")  # out[2] … out[5]
 FEW_CHANGES = 16  # state changes in a window up to which their rows are found in Python
 FEW_CONTACTS = 64  # contacts up to which a window's columns are checked in Python first
+_COUNTING = [list(range(1, n + 1)) for n in range(FEW_CONTACTS + 1)]  # each contact's column + 1, in order
 
 
 @dataclass
@@ -203,7 +204,7 @@ class Window:
         kept = self._columns
         if kept is not None and kept[0] is column and kept[1] == given:
             return kept[2]
-        if given == n and n <= FEW_CONTACTS and column[:n].tolist() == list(range(1, n + 1)):
+        if given == n and n <= FEW_CONTACTS and column[:n].tolist() == _COUNTING[n]:
             contacts = np.arange(n)  # every contact's column its index (declared contacts): no search
             found, owner = (contacts, contacts, True), contacts
         else:
