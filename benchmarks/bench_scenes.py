@@ -128,18 +128,35 @@ def targets(repeats: int, quick: bool) -> None:
                   f"{'' if run.status == 'ok' else '  ' + run.status}")
 
 
+def call_us(scene, q0, v0, solver, h, steps, calls, blocks=7):
+    """CPU µs of one whole `nr.simulate` call of `steps` steps, timed over blocks of `calls` calls
+    (median of the blocks): a clock read costs ~0.5 µs, and timing each call alone would add two
+    to what a one-step call is measured to cost."""
+    args = dict(method="moreau-jean", h=h, solver=solver, repeat_rest=False)
+    for _ in range(max(10, calls // 10)):
+        nr.simulate(scene, q0, v0, h * steps, **args)
+    times = []
+    for _ in range(blocks):
+        t0 = time.process_time()
+        for _ in range(calls):
+            nr.simulate(scene, q0, v0, h * steps, **args)
+        times.append((time.process_time() - t0) / calls * 1e6)
+    return statistics.median(times)
+
+
 def fixed_cost(repeats: int) -> None:
     """Issue 25's fixed cost of a call: 50-step one-body runs through nr.simulate, the whole call
     against its loop (`result.cpu_time_s`, which also counts taking the samples from the loop's
     records), the part outside it, and a one-step call (what a call costs besides its steps:
-    target ≤ 10 yardsticks), in yardsticks; CPU time, medians of `repeats` calls after a few warm ones."""
+    target ≤ 10 yardsticks; timed in blocks of `repeats` calls, `call_us`), in yardsticks; CPU time,
+    medians of `repeats` calls after a few warm ones."""
     print(f"{'fixed cost, 50 steps':28s} {'whole x yd':>10s} {'loop x yd':>9s} {'outside x yd':>12s} "
           f"{'whole/loop':>10s} {'1 step x yd':>11s}")
     for name in ONE_CONTACT + ("BlockOnIncline",):
         toy = getattr(toys, name)()
         scene, (q0, v0) = toy.scene(), toy.initial_state()
         whole, loop, _ = step_us(scene, q0, v0, "lemke", 1e-3, 50, repeats)
-        one, _, _ = step_us(scene, q0, v0, "lemke", 1e-3, 1, repeats)
+        one = call_us(scene, q0, v0, "lemke", 1e-3, 1, repeats)
         yard = yardstick_us(n=5000, repeats=3)
         print(f"toy {name:24s} {whole * 50 / yard:10.1f} {loop * 50 / yard:9.1f} {(whole - loop) * 50 / yard:12.1f} "
               f"{whole / loop:10.2f} {one / yard:11.1f}")

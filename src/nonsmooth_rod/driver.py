@@ -83,9 +83,9 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     impact_stops, callables = _stop_conditions(stop, scene)
     opts = _options(declared.options, method, options, impact_stops)
     _check_refusals(method, declared, scene, opts, t_end - t0)
-    check_output_size(declared.samples_estimate(opts, t_end - t0, save_every), scene, declared.samples_knob)
-    if declared.compiles is not None and declared.compiles(opts):  # say once if numba is missing
-        _jit.warn_once_without_numba()
+    _check_output_size(declared, opts, t_end - t0, save_every, scene)
+    if not _jit.HAVE_NUMBA and declared.compiles is not None and declared.compiles(opts):
+        _jit.warn_once_without_numba()  # said once
     if resume is not None:
         if declared.resumes is None:
             raise InputError(f"resume: only a Moreau–Jean run continues from an end state; method "
@@ -120,6 +120,21 @@ def _check_contacts(method: str, declared, scene: Scene) -> None:
         if type(contact).__name__ not in handled:
             raise InputError(f"method {method!r} does not handle {type(contact).__name__} contacts "
                              f"(contact {contact.name!r}); it handles {', '.join(handled)}")
+
+
+_SIZES_CHECKED: dict = {}  # (options, duration, save_every, dofs, contacts) whose output fits: checked once
+
+
+def _check_output_size(declared, opts, duration: float, save_every, scene: Scene) -> None:
+    """Refuse a run whose samples cannot fit (check_output_size); a call that repeats a checked
+    one (the same options object, duration, save_every, and scene size) is not checked again."""
+    key = (id(opts), duration, save_every, len(scene.bodies), len(scene.contacts))
+    if _SIZES_CHECKED.get(key) is opts:
+        return
+    check_output_size(declared.samples_estimate(opts, duration, save_every), scene, declared.samples_knob)
+    if len(_SIZES_CHECKED) >= MAX_CHECKED_OPTIONS:
+        _SIZES_CHECKED.clear()
+    _SIZES_CHECKED[key] = opts  # (held: the id names it while it is kept)
 
 
 def _check_refusals(method: str, declared, scene: Scene, opts, duration: float) -> None:

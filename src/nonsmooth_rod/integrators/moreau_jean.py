@@ -399,7 +399,7 @@ class MoreauJean:
         stats = {"h": opts.h, "theta": opts.theta, "solver": opts.solver,
                  "compiled": engine.compiled and solver_code is not None,
                  "force_callback": self._calls_back, "stick_predictions": decisions.predictions if decisions else 0}
-        self._predicted_switches = decisions.switches if decisions else {}
+        self._predicted_switches = decisions.switches if decisions else None
         result = self._result(scene, packed, grid, window, collector, work, ending, names, cpu, stats)
         # lent to the next run of the scene, which first has the result copy its end state out of
         # them if it is still alive (a loop that drops each result never copies); a window too
@@ -427,7 +427,7 @@ class MoreauJean:
         """(grid, params, iparams, slip record of a contact out of reach) of a run: kept by the
         scene's plan for its next run from (q0, v0) with the same options object (the driver hands
         the same checked options to runs with the same values), start and end; the parameters
-        copied, for the loop writes into them (a grid is never changed)."""
+        copied, for the loop writes into them (a grid is never changed: its message is formatted once)."""
         kept = plan.parameters
         if resume is None and kept is not None and kept[0] is self.options and _same_float(kept[1], t0) \
                 and _same_float(kept[2], t_end):
@@ -463,7 +463,7 @@ class MoreauJean:
         break-aways reviewed by them; returns (run status, global step the run ended at)."""
         k = grid.first
         if stops and stop_holds(stops, grid.time(k), window.out.q[window.r], window.out.v[window.r]):
-            collector.take(window, k, k, final=True, compiled=engine.compiled)
+            collector.take(window, k, k, True, engine.compiled)
             return loop.RUN_STOPPED_BY_CONDITION, k
         while k < grid.last:
             if window.room() == 0:
@@ -490,10 +490,10 @@ class MoreauJean:
             if k_hold is not None:
                 if k_hold < k_done:  # replay to the step where it holds: the end state is that step's
                     self._replay(engine, scene, window, snapshot, k, k_hold, (step_params, iparams, model, work), held)
-                collector.take(window, k, k_hold, final=True, compiled=engine.compiled)
+                collector.take(window, k, k_hold, True, engine.compiled)
                 return loop.RUN_STOPPED_BY_CONDITION, k_hold
             final = status != loop.RUN_OK or k_done == grid.last
-            collector.take(window, k, k_done, final=final, compiled=engine.compiled)
+            collector.take(window, k, k_done, final, engine.compiled)
             k = k_done
             if status != loop.RUN_OK:
                 return status, k
