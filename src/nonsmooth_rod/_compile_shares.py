@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = 'eb0ca6b628b9c244f782129e63822a63'
+SOURCES = 'b864c6bf5224f6137904b1c20d13b8ed'
 
 SHARES = (
     (

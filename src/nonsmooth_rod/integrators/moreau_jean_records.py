@@ -43,6 +43,9 @@ RECORDS = ("p_normal", "p_tangent", "slip", "states")  # out[2] … out[5]
 FEW_CHANGES = 16  # state changes in a window up to which their rows are found in Python
 FEW_CONTACTS = 64  # contacts up to which a window's columns are checked in Python first
 _COUNTING = [list(range(1, n + 1)) for n in range(FEW_CONTACTS + 1)]  # each contact's column + 1, in order
+# Window.columns where every contact's column is its index: (contacts, columns, True), one per count,
+# shared by every window (only read: indices into records and contacts)
+_IDENTITY = [(np.arange(n), np.arange(n), True) for n in range(FEW_CONTACTS + 1)]
 
 
 @dataclass
@@ -205,8 +208,8 @@ class Window:
         if kept is not None and kept[0] is column and kept[1] == given:
             return kept[2]
         if given == n and n <= FEW_CONTACTS and column[:n].tolist() == _COUNTING[n]:
-            contacts = np.arange(n)  # every contact's column its index (declared contacts): no search
-            found, owner = (contacts, contacts, True), contacts
+            found = _IDENTITY[n]  # every contact's column its index (declared contacts): no search
+            owner = found[0]
         else:
             contacts = np.flatnonzero(column[:n])
             cols = column[contacts] - 1
