@@ -19,6 +19,7 @@ from nonsmooth_rod.validation import (
     require_finite,
     require_name,
     require_state,
+    require_states,
 )
 
 pytestmark = pytest.mark.no_compiled_loop  # runs no compiled loop: scheduled first (tests/conftest.py)
@@ -98,3 +99,22 @@ def test_names_without_control_characters(name):
 def test_a_state_is_numbers(value):
     with pytest.raises(InputError, match="must be a sequence of 3 numbers"):
         require_state("q0", value, 3)
+
+
+@pytest.mark.parametrize("bad", [[np.nan, 0.0, 0.0], np.array([0.0, np.inf, 0.0]), np.array([1e200, 0.0, 0.0]),
+                                 np.array([0.0, 0.0]), np.zeros(3, dtype=np.float32) + np.nan, None, "abc"])
+@pytest.mark.parametrize("which", ["q0", "v0"])
+def test_both_states_at_once_refuse_what_each_alone_refuses(bad, which):
+    """require_states (the driver's one call for q0 and v0, a fast path for two small float64
+    arrays) refuses exactly what require_state does, naming the state; what it accepts it copies."""
+    good = np.array([0.1, -0.2, 0.3])
+    args = (bad, good) if which == "q0" else (good, bad)
+    with pytest.raises(InputError) as alone:
+        require_state(which, bad, 3)
+    with pytest.raises(InputError) as together:
+        require_states(*args, 3)
+    assert str(together.value) == str(alone.value) and which in str(together.value)
+    q0, v0 = require_states(good, good, 3)
+    assert q0 is not good and v0 is not good and np.array_equal(q0, good) and np.array_equal(v0, good)
+    big = np.full(3, 0.6e100)  # each within the bound, their sum over it: checked one by one, accepted
+    assert np.array_equal(require_states(big, big, 3)[1], big)

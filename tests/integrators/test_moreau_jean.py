@@ -135,3 +135,31 @@ def test_block_slides_with_the_dynamic_coefficient():
     expected = -G * (math.sin(alpha) - mu_d * math.cos(alpha))  # down the slope: −t direction
     assert np.allclose(accel, expected, rtol=1e-6)
     assert set(res.trajectory.modes[1:].ravel()) == {"slip-"}
+
+
+def test_blas_is_held_to_one_thread_from_the_limits_step_count_on(monkeypatch):
+    """A run of BLAS_LIMIT_STEPS steps or more holds BLAS to one thread (_jit.one_blas_thread); a
+    shorter one leaves it as it is (setting and restoring it cost more than its few LAPACK calls),
+    and runs the same steps: the limit changes no result."""
+    import contextlib
+
+    import nonsmooth_rod as nr
+    from nonsmooth_rod import _jit, toys
+    from nonsmooth_rod.integrators import moreau_jean
+
+    entered = []
+
+    @contextlib.contextmanager
+    def recorded():
+        entered.append(True)
+        yield
+
+    monkeypatch.setattr(_jit, "one_blas_thread", recorded)
+    toy = toys.BouncingBall()
+    scene, (q0, v0) = toy.scene(), toy.initial_state()
+    h, limit = 1e-3, moreau_jean.BLAS_LIMIT_STEPS
+    short = nr.simulate(scene, q0, v0, (limit - 1) * h, h=h)
+    assert not entered and short.steps == limit - 1
+    long = nr.simulate(scene, q0, v0, limit * h, h=h)
+    assert entered == [True] and long.steps == limit
+    np.testing.assert_array_equal(long.q[:limit], short.q)
