@@ -195,8 +195,9 @@ def test_the_arrays_a_plan_lends_are_bounded():
     plan = scene_plan(scene)
     assert len(plan._spares) == scene_plans.MAX_SPARES
     long_window = Window(scene.n_dof, 1, 50_000)
-    _lend(plan, None, _new_work(1, scene.n_dof, plan.joints), long_window)
+    assert not _lend(plan, None, _new_work(1, scene.n_dof, plan.joints), long_window)
     assert long_window.rows not in plan._spares
+    assert all(kept[0][1] is not long_window.out for kept in plan._owners.values())  # nor kept alive
     del kept  # their results gone: every set free
     taken = [plan.borrow(HISTORY + 5) for _ in range(scene_plans.SETS_PER_KEY)]
     assert all(t is not None for t in taken) and plan.borrow(HISTORY + 5) is None  # each set to one run at a time

@@ -95,16 +95,19 @@ class ScenePlan:
     def give_back(self, key, arrays, max_bytes: float = float("inf"), holder=None) -> bool:
         """Lend `arrays` (a set: sequences of arrays, the loop's tuples) to the next run that asks
         for `key` (SETS_PER_KEY sets a key, MAX_SPARES keys), when they hold at most `max_bytes`;
-        True if lent. `holder`: the result whose end
-        state is built from them on first read (settled before they are lent again, if it is
-        alive): two sets a key, so that a loop that keeps each result until the next call returns
-        never has one copied."""
+        True if lent. `holder`: the result whose end state is built from them on first read
+        (settled before they are lent again, if it is alive): two sets a key, so that a loop that
+        keeps each result until the next call returns never has one copied. A set too large is
+        not remembered either (a long run's window is not kept alive by the plan)."""
         known = self._owners.get(id(arrays))
         if known is None or known[0] is not arrays:  # the same sets come back run after run
+            buffers = owners([a for part in arrays for a in part])
+            known = (arrays, buffers, sum(b.nbytes for b in buffers))
+            if known[2] > max_bytes:
+                return False
             if len(self._owners) >= SETS_PER_KEY * MAX_SPARES:
                 self._owners.clear()
-            buffers = owners([a for part in arrays for a in part])
-            known = self._owners[id(arrays)] = (arrays, buffers, sum(b.nbytes for b in buffers))
+            self._owners[id(arrays)] = known
         if known[2] > max_bytes:
             return False
         if key not in self._spares and len(self._spares) >= MAX_SPARES:
