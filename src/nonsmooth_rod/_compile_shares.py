@@ -4,7 +4,7 @@ for. Written by `python -m nonsmooth_rod._loop_callees`; do not edit (tests/engi
 test_compile_split.py checks it against the loop, typing the loop again when SOURCES is
 not the sources' key: _loop_callees.sources_key)."""
 
-SOURCES = 'f5e697286f456f81e0a1eb72e09abc23'
+SOURCES = 'c07984dc96f065e39b2f29db32497dfd'
 
 SHARES = (
     (

@@ -100,17 +100,11 @@ def simulate(scene: Scene, q0, v0, t_end: float, method: str = "moreau-jean", *,
     return result
 
 
-_KNOWN_METHODS: dict = {}  # method name → its integrator class, once asked for
-
-
 def _integrator_class(method):
-    known = _KNOWN_METHODS.get(method) if type(method) is str else None
-    if known is not None:
-        return known
-    if not isinstance(method, str) or method not in METHODS:
-        raise InputError(f"unknown method {quoted(method)}; choose from: {', '.join(METHODS)}")
-    known = _KNOWN_METHODS[method] = integrator_class(method)
-    return known
+    try:  # (integrator_class keeps each class: one lookup a call)
+        return integrator_class(method)
+    except (KeyError, TypeError):  # an unknown name, or not a name at all
+        raise InputError(f"unknown method {quoted(method)}; choose from: {', '.join(METHODS)}") from None
 
 
 def _check_contacts(method: str, declared, scene: Scene) -> None:

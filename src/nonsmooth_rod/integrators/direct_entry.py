@@ -44,11 +44,8 @@ class DirectEntry:
 
     def _learn(self, dispatcher, model, work, out) -> None:
         """After a call through the dispatcher: know its arguments when it holds one overload."""
-        overloads = getattr(dispatcher, "overloads", None)  # (none: the interpreted twin)
-        entry = None
-        if overloads is not None and len(overloads) == 1:
-            entry = getattr(next(iter(overloads.values())), "entry_point", None)
-        if entry is None or not callable(entry):
+        entry = one_overload_entry(dispatcher)
+        if entry is None:
             self._state = (None, None, {})
             return
         # their largest arrays: the contacts' table and memory, the records' states and impulses
@@ -62,4 +59,15 @@ class DirectEntry:
         self._state = (dispatcher, entry, known)
 
 
-__all__ = ["DirectEntry"]
+def one_overload_entry(dispatcher):
+    """The entry point of `dispatcher`'s one compiled overload (the one every call since used,
+    when its arguments are built the same way), or None: none yet, several, or no dispatcher (an
+    interpreted twin, or the plain function without numba)."""
+    overloads = getattr(dispatcher, "overloads", None)
+    if overloads is None or len(overloads) != 1:
+        return None
+    entry = getattr(next(iter(overloads.values())), "entry_point", None)
+    return entry if callable(entry) else None
+
+
+__all__ = ["DirectEntry", "one_overload_entry"]

@@ -1,14 +1,16 @@
 """The kernel that takes a Moreau–Jean run's kept samples from its window of rows
 (moreau_jean_records.Collector): one compiled call a window, where numpy's calls over a short
 run's row or two cost more than its steps (docs/performance.md, "The fixed cost of a call").
-A module of its own: it imports nothing of the package but `_jit`, so that an edit of the
-records' Python, or of what they import, leaves the compiled kernels' cache alone (_jit's purge).
+A module of its own: it imports nothing of the package but `_jit` and `direct_entry`, so that
+an edit of the records' Python, or of what they import, leaves the compiled kernels' cache alone
+(_jit's purge).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .._jit import jit_borrowing
+from .direct_entry import one_overload_entry
 
 
 @jit_borrowing
@@ -70,11 +72,8 @@ def compiled_samples():
         return _ENTRY
     materialized = getattr(samples_into, "materialized", None)  # (a _jit.LazyKernel before numba loads)
     dispatcher = samples_into if materialized is None else materialized()
-    overloads = getattr(dispatcher, "overloads", None)  # (none without numba: the plain function)
-    if overloads is not None and len(overloads) == 1:
-        _ENTRY = next(iter(overloads.values())).entry_point
-        return _ENTRY
-    return dispatcher
+    _ENTRY = one_overload_entry(dispatcher)
+    return dispatcher if _ENTRY is None else _ENTRY
 
 
 __all__ = ["samples_into", "compiled_samples"]

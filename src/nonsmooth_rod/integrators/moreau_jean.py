@@ -427,7 +427,7 @@ class MoreauJean:
         """(grid, params, iparams, slip record of a contact out of reach) of a run: kept by the
         scene's plan for its next run from (q0, v0) with the same options object (the driver hands
         the same checked options to runs with the same values), start and end; the parameters
-        copied, for the loop writes into them (a grid is never changed: its message is formatted once)."""
+        copied, for the loop writes into them (a grid is never changed)."""
         kept = plan.parameters
         if resume is None and kept is not None and kept[0] is self.options and _same_float(kept[1], t0) \
                 and _same_float(kept[2], t_end):
@@ -472,7 +472,7 @@ class MoreauJean:
                 window.slide()
             last = bool(grid.h_last) and k == grid.last - 1
             n = engine.steps(1 if last else min(window.room(), grid.first + grid.n_full - k))
-            held, taken_back = _NOTHING, False
+            held, taken_back = None, False
             if decisions is not None:  # cut at the holds it plans, run in them
                 n, held, taken_back = decisions.chunk(window, k, n)
             step_params = self._shortened(params, grid, window, k) if last else params
@@ -517,17 +517,17 @@ class MoreauJean:
         p[loop.P_H], p[loop.P_T0], p[loop.P_K0] = grid.h_last, grid.origin + float(k) * grid.h, -float(k - window.k_base)
         return p
 
-    def _advance(self, engine, scene, window, n, params, iparams, model, work, held=_NOTHING):
+    def _advance(self, engine, scene, window, n, params, iparams, model, work, held=None):
         """n steps from the window's current row with the engine's kernels (compiled, or their
-        interpreted twins) in the context `held` (the chunk's holds: stick_decisions); returns
+        interpreted twins) in the context `held` (the chunk's holds: stick_decisions; None: none); returns
         (run status, global step reached)."""
         r0 = window.r
         window.out.counters[loop.K_DONE] = r0
         compiling = _NOTHING if engine.warm else engine.compiling()
-        if held is _NOTHING and compiling is _NOTHING:  # (most chunks: no context's Python calls)
+        if held is None and compiling is _NOTHING:  # (most chunks: no context's Python calls)
             status = self._steps(engine.kernels, scene, window, r0, n, params, iparams, model, work)
         else:
-            with held, compiling:
+            with held or _NOTHING, compiling:
                 status = self._steps(engine.kernels, scene, window, r0, n, params, iparams, model, work)
         window.r = int(window.out.counters[loop.K_DONE])
         return int(status), window.k_base + window.r
@@ -615,8 +615,6 @@ class MoreauJean:
     def _ending(self, status, k_end, grid, window, names):
         """(status word, message, solver-failure event or None) of how the run ended at step k_end."""
         if status == loop.RUN_OK:
-            if grid.reached is None:
-                grid.reached = f"reached t_end = {grid.t_end:g} s"
             return Status.OK, grid.reached, None
         if status == loop.RUN_STOPPED:
             return Status.OK, f"stopped at the impact of {self.options.stop_at_impact}", None
@@ -668,10 +666,7 @@ class MoreauJean:
     def _result(self, scene, packed, grid, window, collector, work, ending, names, cpu, stats) -> SimulationResult:
         """The run's result (`stats`: the run's own dict, completed here with the loop's counts)."""
         run_status, k_end = ending
-        if run_status == loop.RUN_OK and grid.reached is not None:  # (the common ending, its message known)
-            status, message, final_event = Status.OK, grid.reached, None
-        else:
-            status, message, final_event = self._ending(run_status, k_end, grid, window, names)
+        status, message, final_event = self._ending(run_status, k_end, grid, window, names)
         impacts, events = self._impacts(scene, grid, collector, names) if collector.impact_rows else ([], [])
         counters = window.out.counters
         t, q, v, a, N, T, codes = collector.trajectory_arrays()

@@ -124,7 +124,7 @@ class Grid:
         # dozen times, and a cached property's first read (its lock) costs more than computing both
         self.n_steps: int = self.n_full + (1 if self.h_last else 0)
         self.last: int = self.first + self.n_steps
-        self.reached = None  # a run's message on reaching t_end, formatted once (the plan keeps the grid)
+        self.reached = f"reached t_end = {self.t_end:g} s"  # a run's message then (formatted once a grid)
 
     def time(self, k: np.ndarray | int):
         """Times of global step indices (the last one: t_end exactly)."""

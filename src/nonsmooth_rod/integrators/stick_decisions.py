@@ -42,7 +42,6 @@ first step (the earlier run's holds are not carried over).
 """
 from __future__ import annotations
 
-import contextlib
 import functools
 import math
 from typing import NamedTuple
@@ -70,7 +69,6 @@ RELEASE_STEPS = 2
 SLIDING = (STATE_SLIP_PLUS, STATE_SLIP_MINUS)
 NOT_PREDICTED = "not predicted"  # a mode run the compiled mode solve declines: the step's law decides
 MAX_PREDICTORS = 2  # predicting Hybrids a scene's plan keeps (threads running the scene at once)
-_NO_HOLDS = contextlib.nullcontext()  # (reusable: it does nothing on entering and leaving)
 
 
 class _ModeRun(NamedTuple):  # (a tuple: made at every call's first review, a frozen dataclass costs a µs more)
@@ -118,18 +116,19 @@ class StickDecisions:
         self._ahead: dict = {}  # a mode run's first step → its prediction (each contact's break-away reads it)
 
     def chunk(self, window, k: int, n: int):
-        """(steps, context, whether the review may take steps back) of the chunk from step k of
-        at most n steps: cut so that a chunk starts at every planned hold's and release's first
+        """(steps, context or None, whether the review may take steps back) of the chunk from step
+        k of at most n steps: cut so that a chunk starts at every planned hold's and release's first
         and last step; run in its held contacts' friction raised in the packed table and its
-        released ones' μs lowered to μd (restored after); the review compares the modes of
-        consecutive rows from the one before the chunk's (a run's first chunk of one step has no two)."""
+        released ones' μs lowered to μd (restored after; None: nothing held or released); the
+        review compares the modes of consecutive rows from the one before the chunk's (a run's
+        first chunk of one step has no two)."""
+        context = None  # (a run without holds: every call's first chunk)
         if self.held or self.released:
             bounds = [b for plan in (self.held, self.released) for span in plan.values() for b in span]
             n = min([n] + [b - k for b in bounds if b > k])
             held, released = _during(self.held, k), _during(self.released, k)
-            context = self.smooth.Held(self.table, held, released) if held or released else _NO_HOLDS
-        else:  # (a run without holds: every call's first chunk)
-            context = _NO_HOLDS
+            if held or released:
+                context = self.smooth.Held(self.table, held, released)
         return n, context, self.handled and (n > 1 or k > window.k_base)
 
     def review(self, window, k: int, k_done: int) -> int | None:
